@@ -1,0 +1,25 @@
+// `needle`: the toolkit's one command. Each subcommand lives in its own file.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <fmt/format.h>
+
+#include "apps/tip_command.h"
+#include "geometry/input_error.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"needle: design biopsy needle tips - grinding CAD, meshing and insertion simulation"};
+  app.require_subcommand(1);
+  needle::add_tip_command(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const needle::InputError& e) {
+    fmt::print(stderr, "needle: error: {}\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "needle: failed: {}\n", e.what());
+    return 1;
+  }
+  return 0;
+}

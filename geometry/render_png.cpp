@@ -1,0 +1,191 @@
+#include "geometry/render_png.h"
+
+#include <ft2build.h>
+#include FT_FREETYPE_H
+#include <png.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fmt/format.h>
+#include <limits>
+#include <vector>
+
+#include "geometry/input_error.h"
+#include "geometry/mesh_io.h"
+#include "geometry/tag_colors.h"
+
+namespace needle {
+namespace {
+
+struct Image {
+  int width, height;
+  std::vector<unsigned char> rgb;
+  Image(int w, int h) : width(w), height(h), rgb(3 * w * h, 255) {}
+  void set(int x, int y, const std::array<unsigned char, 3>& c) {
+    if (x < 0 || y < 0 || x >= width || y >= height) return;
+    std::copy(c.begin(), c.end(), rgb.begin() + 3 * (y * width + x));
+  }
+  void blend(int x, int y, const std::array<unsigned char, 3>& c, double alpha) {
+    if (x < 0 || y < 0 || x >= width || y >= height) return;
+    for (int k = 0; k < 3; ++k) {
+      unsigned char& p = rgb[3 * (y * width + x) + k];
+      p = static_cast<unsigned char>(std::lround(p * (1 - alpha) + c[k] * alpha));
+    }
+  }
+};
+
+// Text through FreeType with the DejaVu font Debian ships; silently no text if the font is absent.
+class TextWriter {
+ public:
+  explicit TextWriter(int pixel_size) {
+    if (FT_Init_FreeType(&library_)) return;
+    for (const char* font : {"/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
+                             "/usr/share/fonts/TTF/DejaVuSans.ttf"})
+      if (!FT_New_Face(library_, font, 0, &face_)) break;
+    if (face_) FT_Set_Pixel_Sizes(face_, 0, pixel_size);
+  }
+  ~TextWriter() {
+    if (face_) FT_Done_Face(face_);
+    if (library_) FT_Done_FreeType(library_);
+  }
+  void draw(Image& image, int x, int baseline, const std::string& text, const std::array<unsigned char, 3>& color) {
+    if (!face_) return;
+    for (char c : text) {
+      if (FT_Load_Char(face_, static_cast<unsigned char>(c), FT_LOAD_RENDER)) continue;
+      const FT_GlyphSlot g = face_->glyph;
+      for (unsigned row = 0; row < g->bitmap.rows; ++row)
+        for (unsigned col = 0; col < g->bitmap.width; ++col) {
+          const double alpha = g->bitmap.buffer[row * g->bitmap.pitch + col] / 255.0;
+          if (alpha > 0) image.blend(x + g->bitmap_left + col, baseline - g->bitmap_top + row, color, alpha);
+        }
+      x += g->advance.x >> 6;
+    }
+  }
+
+ private:
+  FT_Library library_ = nullptr;
+  FT_Face face_ = nullptr;
+};
+
+// Orthographic view along -eye, the needle axis kept horizontal on screen.
+void draw_panel(const TriSurface& s, const RenderOptions& options, const Eigen::Vector3d& eye_dir, Image& image,
+                int x0, int y0, int w, int h) {
+  const Eigen::Vector3d eye = eye_dir.normalized();
+  Eigen::Vector3d right = Eigen::Vector3d::UnitX() - eye.x() * eye;
+  right.normalize();
+  const Eigen::Vector3d up = eye.cross(right);
+  std::vector<int> faces;
+  double min_u = 1e300, max_u = -1e300, min_v = 1e300, max_v = -1e300;
+  for (int f = 0; f < s.num_faces(); ++f) {
+    bool keep = false;
+    for (int k = 0; k < 3; ++k) keep = keep || s.V(s.F(f, k), 0) >= options.view_from_x_mm;
+    if (!keep) continue;
+    faces.push_back(f);
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d p = s.V.row(s.F(f, k));
+      if (p.x() < options.view_from_x_mm) continue;
+      min_u = std::min(min_u, p.dot(right)), max_u = std::max(max_u, p.dot(right));
+      min_v = std::min(min_v, p.dot(up)), max_v = std::max(max_v, p.dot(up));
+    }
+  }
+  if (faces.empty()) return;
+  const double scale = 0.92 * std::min(w / (max_u - min_u), h / (max_v - min_v));
+  const double cu = 0.5 * (min_u + max_u), cv = 0.5 * (min_v + max_v);
+  std::vector<double> depth(static_cast<size_t>(w) * h, -std::numeric_limits<double>::infinity());
+  const Eigen::Vector3d light = (eye + 0.4 * up).normalized();
+  for (int f : faces) {
+    Eigen::Vector3d p[3];
+    double sx[3], sy[3], sz[3];
+    for (int k = 0; k < 3; ++k) {
+      p[k] = s.V.row(s.F(f, k));
+      sx[k] = 0.5 * w + (p[k].dot(right) - cu) * scale;
+      sy[k] = 0.5 * h - (p[k].dot(up) - cv) * scale;
+      sz[k] = p[k].dot(eye);
+    }
+    Eigen::Vector3d n = (p[1] - p[0]).cross(p[2] - p[0]);
+    if (n.norm() == 0 || n.dot(eye) <= 0) continue;  // back face
+    n.normalize();
+    const double shade = 0.35 + 0.65 * std::abs(n.dot(light));
+    std::array<unsigned char, 3> color = tag_color(s.face_tag.size() ? s.tag_names[s.face_tag(f)] : "shaft");
+    for (auto& c : color) c = static_cast<unsigned char>(std::min(255.0, c * shade));
+    const int bx0 = std::max(0, static_cast<int>(std::floor(std::min({sx[0], sx[1], sx[2]}))));
+    const int bx1 = std::min(w - 1, static_cast<int>(std::ceil(std::max({sx[0], sx[1], sx[2]}))));
+    const int by0 = std::max(0, static_cast<int>(std::floor(std::min({sy[0], sy[1], sy[2]}))));
+    const int by1 = std::min(h - 1, static_cast<int>(std::ceil(std::max({sy[0], sy[1], sy[2]}))));
+    const double area = (sx[1] - sx[0]) * (sy[2] - sy[0]) - (sx[2] - sx[0]) * (sy[1] - sy[0]);
+    if (std::abs(area) < 1e-12) continue;
+    for (int y = by0; y <= by1; ++y)
+      for (int x = bx0; x <= bx1; ++x) {
+        const double px = x + 0.5, py = y + 0.5;
+        const double w0 = ((sx[1] - px) * (sy[2] - py) - (sx[2] - px) * (sy[1] - py)) / area;
+        const double w1 = ((sx[2] - px) * (sy[0] - py) - (sx[0] - px) * (sy[2] - py)) / area;
+        const double w2 = 1 - w0 - w1;
+        if (w0 < 0 || w1 < 0 || w2 < 0) continue;
+        const double z = w0 * sz[0] + w1 * sz[1] + w2 * sz[2];
+        const double x_world = w0 * p[0].x() + w1 * p[1].x() + w2 * p[2].x();
+        if (x_world < options.view_from_x_mm) continue;
+        double& d = depth[static_cast<size_t>(y) * w + x];
+        if (z <= d) continue;
+        d = z;
+        image.set(x0 + x, y0 + y, color);
+      }
+  }
+}
+
+void write_png(const Image& image, const std::string& path) {
+  FILE* file = std::fopen(path.c_str(), "wb");
+  if (!file) throw std::runtime_error(fmt::format("cannot open '{}' for writing", path));
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  png_infop info = png_create_info_struct(png);
+  if (setjmp(png_jmpbuf(png))) {
+    png_destroy_write_struct(&png, &info);
+    std::fclose(file);
+    throw std::runtime_error(fmt::format("libpng failed writing '{}'", path));
+  }
+  png_init_io(png, file);
+  png_set_IHDR(png, info, image.width, image.height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  png_write_info(png, info);
+  for (int y = 0; y < image.height; ++y)
+    png_write_row(png, const_cast<png_bytep>(image.rgb.data() + 3 * y * image.width));
+  png_write_end(png, nullptr);
+  png_destroy_write_struct(&png, &info);
+  std::fclose(file);
+}
+
+}  // namespace
+
+void render_tip_png(const TriSurface& s, const std::string& path, const RenderOptions& options) {
+  const int w = options.panel_width_px, h = options.panel_height_px, header = 40, legend = 34;
+  Image image(w, 2 * h + header + legend);
+  TextWriter text(18), small(15);
+  const std::array<unsigned char, 3> ink = {30, 30, 30};
+  text.draw(image, 12, 27, options.title, ink);
+  draw_panel(s, options, Eigen::Vector3d(0.45, 0.75, 0.55), image, 0, header, w, h);
+  small.draw(image, 12, header + 20, "from above (+y, groove side)", ink);
+  draw_panel(s, options, Eigen::Vector3d(0.45, -0.75, 0.55), image, 0, header + h, w, h);
+  small.draw(image, 12, header + h + 20, "from below (-y)", ink);
+  int x = 12;
+  const int y = header + 2 * h + 8;
+  for (const std::string& name : s.tag_names) {
+    const auto color = tag_color(name);
+    for (int dy = 0; dy < 16; ++dy)
+      for (int dx = 0; dx < 16; ++dx) image.set(x + dx, y + dy, color);
+    small.draw(image, x + 21, y + 14, name, ink);
+    x += 26 + 9 * static_cast<int>(name.size()) + 14;
+  }
+  const std::string scratch = scratch_dir_beside(path);
+  const std::string name = std::filesystem::path(path).filename().string();
+  try {
+    write_png(image, (std::filesystem::path(scratch) / name).string());
+    commit_scratch_file(scratch, name, std::filesystem::path(path).parent_path().string());
+  } catch (...) {
+    std::filesystem::remove_all(scratch);
+    throw;
+  }
+  std::filesystem::remove_all(scratch);
+}
+
+}  // namespace needle

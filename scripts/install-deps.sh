@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# Installs every build and test dependency of the project from Debian's packages.
+# Safe to run again: apt-get skips what is already there.
+set -euo pipefail
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+PACKAGES=(
+  build-essential cmake ninja-build pkg-config
+  libcgal-dev libgmp-dev libmpfr-dev libboost-dev
+  libgmsh-dev
+  libeigen3-dev
+  libassimp-dev
+  libopenvdb-dev libboost-iostreams-dev libtbb-dev
+  catch2
+  nlohmann-json3-dev libcli11-dev libfmt-dev libspdlog-dev
+  libpng-dev libfreetype-dev fonts-dejavu-core
+)
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ "${#missing[@]}" -eq 0 ]; then
+  echo "install-deps: all ${#PACKAGES[@]} packages already installed"
+  exit 0
+fi
+echo "install-deps: installing ${missing[*]}"
+$SUDO apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
