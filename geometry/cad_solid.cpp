@@ -8,6 +8,8 @@
 #include <CGAL/Surface_mesh.h>
 #include <algorithm>
 #include <chrono>
+#include <map>
+#include <tuple>
 #include <cstdlib>
 #define NEEDLE_TRACE(...) if (std::getenv("NEEDLE_DEBUG")) fmt::print(stderr, __VA_ARGS__)
 #include <fmt/format.h>
@@ -121,8 +123,8 @@ CadSolid build_cad_solid(const GrindingRecipe& recipe, bool half_model) {
   }
   pieces.push_back(tessellate_rod(tip, angles, std::vector<double>(rings.begin(), piece_end), half_model));
   auto on_split = [&](double x) { return std::find(splits.begin(), splits.end(), x) != splits.end(); };
-  TriSurface merged;
   std::vector<Eigen::Vector3d> vertices;
+  std::map<std::tuple<double, double, double>, int> ring_vertex;
   std::vector<Eigen::Vector3i> faces;
   for (size_t k = 0; k < pieces.size(); ++k) {
     Mesh mesh = to_cgal(pieces[k]);
@@ -140,21 +142,42 @@ CadSolid build_cad_solid(const GrindingRecipe& recipe, bool half_model) {
     PMP::remove_degenerate_faces(mesh);
     mesh.collect_garbage();
     if (!CGAL::is_closed(mesh)) throw std::runtime_error("the CAD solid is not closed after the booleans");
+    // Join the pieces: only vertices on a split ring are shared (by exact position); inside a piece
+    // CGAL's connectivity is kept as is, even where two vertices round to the same double.
     const TriSurface part = from_cgal(mesh);
-    const int offset = static_cast<int>(vertices.size());
-    for (int v = 0; v < part.num_vertices(); ++v) vertices.push_back(part.V.row(v).transpose());
+    std::vector<int> global(part.num_vertices());
+    for (int v = 0; v < part.num_vertices(); ++v) {
+      const Eigen::Vector3d p = part.V.row(v).transpose();
+      if (on_split(p.x())) {
+        const auto key = std::make_tuple(p.x(), p.y(), p.z());
+        const auto found = ring_vertex.find(key);
+        if (found != ring_vertex.end()) {
+          global[v] = found->second;
+          continue;
+        }
+        ring_vertex.emplace(key, static_cast<int>(vertices.size()));
+      }
+      global[v] = static_cast<int>(vertices.size());
+      vertices.push_back(p);
+    }
     for (int f = 0; f < part.num_faces(); ++f) {
       const double x0 = part.V(part.F(f, 0), 0);
       const bool on_split_cap = on_split(x0) && part.V(part.F(f, 1), 0) == x0 && part.V(part.F(f, 2), 0) == x0;
-      if (!on_split_cap) faces.push_back(part.F.row(f).transpose().array() + offset);
+      if (!on_split_cap) faces.emplace_back(global[part.F(f, 0)], global[part.F(f, 1)], global[part.F(f, 2)]);
     }
   }
-  merged.V.resize(vertices.size(), 3);
-  for (size_t v = 0; v < vertices.size(); ++v) merged.V.row(v) = vertices[v].transpose();
-  merged.F.resize(faces.size(), 3);
-  for (size_t f = 0; f < faces.size(); ++f) merged.F.row(f) = faces[f].transpose();
-  merged.face_tag = Eigen::VectorXi::Zero(merged.num_faces());
-  solid.surface = weld_identical_vertices(merged);
+  // Drop the cap-centre vertices the dropped caps used.
+  std::vector<int> used(vertices.size(), -1);
+  int count = 0;
+  for (const Eigen::Vector3i& face : faces)
+    for (int k = 0; k < 3; ++k)
+      if (used[face(k)] < 0) used[face(k)] = count++;
+  solid.surface.V.resize(count, 3);
+  for (size_t v = 0; v < vertices.size(); ++v)
+    if (used[v] >= 0) solid.surface.V.row(used[v]) = vertices[v].transpose();
+  solid.surface.F.resize(faces.size(), 3);
+  for (size_t f = 0; f < faces.size(); ++f)
+    for (int k = 0; k < 3; ++k) solid.surface.F(f, k) = used[faces[f](k)];
   const TopologyCheck topology = check_topology(solid.surface);
   if (!topology.closed_manifold())
     throw std::runtime_error("the CAD solid is not a closed manifold: " + topology.describe());

@@ -107,20 +107,6 @@ void validate_recipe(const GrindingRecipe& recipe) {
       NEEDLE_REQUIRE(&other == &grind || other.name != grind.name,
                      fmt::format("two grinds are named '{}': facet names must be unique", grind.name));
   }
-  if (any_through_tip) {
-    NEEDLE_REQUIRE(recipe.tip_y_mm.has_value(),
-                   "grinds through the tip point need the tip point: give d_a_mm or tip y_mm");
-    const double tip_y = *recipe.tip_y_mm;
-    NEEDLE_REQUIRE(std::isfinite(tip_y), "tip point y is not a number");
-    const double floor_y = recipe.groove ? groove_floor_y_mm(recipe.rod, *recipe.groove) : 0.0;
-    NEEDLE_REQUIRE(std::abs(tip_y) <= radius * (1.0 + 1e-12),
-                   recipe.groove
-                       ? fmt::format("d_a = {:.4g} mm puts tip point A at y = {:.4g} mm, outside the "
-                                     "rod (|y| <= {} mm): d_a must lie in [{:.4g}, {:.4g}] mm",
-                                     tip_y - floor_y, tip_y, radius, -radius - floor_y, radius - floor_y)
-                       : fmt::format("tip point y = {:.4g} mm lies outside the rod (|y| <= {} mm)",
-                                     tip_y, radius));
-  }
   if (recipe.groove) {
     const Groove& g = *recipe.groove;
     NEEDLE_REQUIRE(std::isfinite(g.length_mm) && g.length_mm > 0.0,
@@ -140,6 +126,20 @@ void validate_recipe(const GrindingRecipe& recipe) {
                    fmt::format("groove ({} mm long, starting {} mm behind the tip) runs past the rod's "
                                "base at {} mm",
                                g.length_mm, g.start_behind_tip_mm, recipe.rod.length_mm));
+  }
+  if (any_through_tip) {
+    NEEDLE_REQUIRE(recipe.tip_y_mm.has_value(),
+                   "grinds through the tip point need the tip point: give d_a_mm or tip y_mm");
+    const double tip_y = *recipe.tip_y_mm;
+    NEEDLE_REQUIRE(std::isfinite(tip_y), "tip point y is not a number");
+    const double floor_y = recipe.groove ? groove_floor_y_mm(recipe.rod, *recipe.groove) : 0.0;
+    NEEDLE_REQUIRE(std::abs(tip_y) <= radius * (1.0 + 1e-12),
+                   recipe.groove
+                       ? fmt::format("d_a = {:.4g} mm puts tip point A at y = {:.4g} mm, outside the "
+                                     "rod (|y| <= {} mm): d_a must lie in [{:.4g}, {:.4g}] mm",
+                                     tip_y - floor_y, tip_y, radius, -radius - floor_y, radius - floor_y)
+                       : fmt::format("tip point y = {:.4g} mm lies outside the rod (|y| <= {} mm)",
+                                     tip_y, radius));
   }
 }
 

@@ -1,0 +1,67 @@
+// `needle tip` end to end, as a user runs it: exit codes, JSON fields, files written or not.
+#include <catch2/catch.hpp>
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <sys/wait.h>
+
+namespace fs = std::filesystem;
+
+namespace {
+struct Result {
+  int exit_code;
+  std::string out;
+};
+Result run(const std::string& args) {
+  const std::string command = std::string(NEEDLE_BINARY) + " " + args + " 2>/dev/null";
+  FILE* pipe = popen(command.c_str(), "r");
+  REQUIRE(pipe);
+  std::string out;
+  std::array<char, 4096> buffer;
+  size_t n;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) out.append(buffer.data(), n);
+  const int status = pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+}  // namespace
+
+TEST_CASE("needle tip --preset LMB --json prints the report", "[apps][cli]") {
+  const Result r = run("tip --preset LMB --json");
+  REQUIRE(r.exit_code == 0);
+  const auto j = nlohmann::json::parse(r.out);
+  CHECK(j["d_a_mm"].get<double>() == Approx(-0.22));
+  CHECK(j["tip_point_mm"][1].get<double>() == Approx(-0.29));
+  CHECK(j["groove"]["face_y_mm"].get<double>() == Approx(-0.07));
+  CHECK(j["groove"]["start_mm"].get<double>() == Approx(3.0));
+  CHECK(j["groove"]["length_mm"].get<double>() == Approx(22.0));
+  REQUIRE(j["facets"].size() == 4);
+  for (const auto& f : j["facets"]) {
+    CHECK(f.contains("name"));
+    CHECK(f["normal"].size() == 3);
+    CHECK(f["point_mm"].size() == 3);
+    CHECK(std::abs(f["area_mm2"].get<double>() / f["area_exact_mm2"].get<double>() - 1) < 0.005);
+  }
+}
+
+TEST_CASE("needle tip --d-a writes every format; bad input writes nothing", "[apps][cli][errors]") {
+  const fs::path dir = fs::temp_directory_path() / "needle-cli-test";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string d = dir.string();
+  CHECK(run("tip --d-a -0.1 --top-tilt-deg 25 --half --out " + d + "/t.glb --png " + d + "/t.png").exit_code == 0);
+  CHECK(fs::file_size(dir / "t.glb") > 1000);
+  CHECK(fs::file_size(dir / "t.png") > 1000);
+  CHECK(run("tip --analyze " + d + "/t.glb --json").exit_code == 0);
+
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  CHECK(run("tip --preset XYZ --out " + d + "/a.stl").exit_code == 2);
+  CHECK(run("tip --d-a 0.9 --out " + d + "/b.stl --png " + d + "/b.png").exit_code == 2);
+  CHECK(run("tip --preset SB --out " + d + "/c.step").exit_code == 2);
+  CHECK(run("tip --preset SB --d-a 0.1").exit_code == 2);
+  CHECK(run("tip --analyze " + d + "/nothing.stl").exit_code == 2);
+  CHECK(run("tip --preset SB --out /nonexistent-folder/x.stl").exit_code == 2);
+  CHECK(run("tip --bogus-flag").exit_code != 0);
+  CHECK(fs::is_empty(dir));
+}

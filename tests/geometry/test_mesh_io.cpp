@@ -1,0 +1,76 @@
+// Every exported format re-imports as a closed manifold with the same area and volume; broken input
+// is refused with a reason.
+#include <catch2/catch.hpp>
+#include <filesystem>
+#include <fstream>
+
+#include "geometry/cad_solid.h"
+#include "geometry/input_error.h"
+#include "geometry/mesh_io.h"
+#include "geometry/surface_measures.h"
+
+using namespace needle;
+namespace fs = std::filesystem;
+
+namespace {
+fs::path fresh_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("needle-test-" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+}  // namespace
+
+TEST_CASE("exported files re-import closed, manifold, with the same area and volume", "[geometry][io]") {
+  const CadSolid solid = build_cad_solid(preset_recipe("LMB"), true);
+  const double area = surface_area_mm2(solid.surface), volume = enclosed_volume_mm3(solid.surface);
+  const fs::path dir = fresh_dir("io");
+  const std::vector<std::pair<std::string, bool>> files = {
+      {"tip.stl", false}, {"tip_ascii.stl", true}, {"tip.obj", false}, {"tip.ply", false}, {"tip.glb", false}, {"tip.gltf", false}};
+  for (const auto& [name, ascii] : files) {
+    const std::string path = (dir / name).string();
+    write_surface(solid.surface, path, surface_format_from_path(path, ascii));
+    const TriSurface back = read_surface(path);
+    INFO(name);
+    CHECK(check_topology(back).closed_manifold());
+    // Single precision may collapse a handful of sliver triangles; the rest must all come back.
+    CHECK(back.num_faces() <= solid.surface.num_faces());
+    CHECK(back.num_faces() >= solid.surface.num_faces() - solid.surface.num_faces() / 1000);
+    // Files store single precision: relative changes of order 1e-7.
+    CHECK(surface_area_mm2(back) == Approx(area).epsilon(1e-5));
+    CHECK(enclosed_volume_mm3(back) == Approx(volume).epsilon(1e-5));
+  }
+  // OBJ and glTF keep the facet tags as mesh names.
+  for (const std::string name : {"tip.obj", "tip.glb"}) {
+    const TriSurface back = read_surface((dir / name).string());
+    const std::vector<double> original = area_by_tag_mm2(solid.surface), areas = area_by_tag_mm2(back);
+    for (const std::string& tag : {"top", "side_pos", "groove_floor", "symmetry"}) {
+      INFO(name << " " << tag);
+      REQUIRE(back.tag_index(tag) >= 0);
+      CHECK(areas[back.tag_index(tag)] == Approx(original[solid.surface.tag_index(tag)]).epsilon(1e-5));
+    }
+  }
+  // No scratch folders are left behind.
+  for (const auto& entry : fs::directory_iterator(dir)) CHECK(entry.path().filename().string().rfind(".needle-partial", 0) != 0);
+}
+
+TEST_CASE("open, unreadable and inside-out surfaces are refused", "[geometry][io][errors]") {
+  const fs::path dir = fresh_dir("bad-io");
+  CadSolid solid = build_cad_solid(preset_recipe("SB"));
+  // Open: drop one triangle.
+  TriSurface open = solid.surface;
+  open.F.conservativeResize(open.F.rows() - 1, 3);
+  open.face_tag.conservativeResize(open.F.rows());
+  write_surface(open, (dir / "open.stl").string(), SurfaceFormat::stl_binary);
+  CHECK_THROWS_WITH(read_surface((dir / "open.stl").string()), Catch::Contains("not a closed"));
+  // Inside out: flip every triangle.
+  TriSurface flipped = solid.surface;
+  flipped.F.col(1).swap(flipped.F.col(2));
+  write_surface(flipped, (dir / "flipped.stl").string(), SurfaceFormat::stl_binary);
+  CHECK_THROWS_WITH(read_surface((dir / "flipped.stl").string()), Catch::Contains("face inward"));
+  // Not a mesh at all.
+  std::ofstream((dir / "garbage.stl").string()) << "this is not an STL file\n";
+  CHECK_THROWS_AS(read_surface((dir / "garbage.stl").string()), InputError);
+  CHECK_THROWS_WITH(read_surface((dir / "missing.stl").string()), Catch::Contains("no such file"));
+  CHECK_THROWS_WITH(surface_format_from_path("tip.step"), Catch::Contains("cannot tell the surface format"));
+}
