@@ -14,7 +14,7 @@ double groove_floor_y_mm(const Rod& rod, const Groove& groove) {
 GrindingRecipe multi_bevel_recipe(double d_a_mm, const MultiBevelAngles& angles, const Rod& rod,
                                   const Groove& groove) {
   GrindingRecipe recipe;
-  recipe.name = fmt::format("multi-bevel d_a={:+.3f} mm", d_a_mm);
+  recipe.name = "multi-bevel";
   recipe.rod = rod;
   recipe.groove = groove;
   recipe.tip_y_mm = groove_floor_y_mm(rod, groove) + d_a_mm;

@@ -107,7 +107,7 @@ void draw_panel(const TriSurface& s, const RenderOptions& options, const Eigen::
     Eigen::Vector3d n = (p[1] - p[0]).cross(p[2] - p[0]);
     if (n.norm() == 0 || n.dot(eye) <= 0) continue;  // back face
     n.normalize();
-    const double shade = 0.35 + 0.65 * std::abs(n.dot(light));
+    const double shade = 0.55 + 0.45 * std::abs(n.dot(light));
     std::array<unsigned char, 3> color = tag_color(s.face_tag.size() ? s.tag_names[s.face_tag(f)] : "shaft");
     for (auto& c : color) c = static_cast<unsigned char>(std::min(255.0, c * shade));
     const int bx0 = std::max(0, static_cast<int>(std::floor(std::min({sx[0], sx[1], sx[2]}))));
@@ -158,7 +158,7 @@ void write_png(const Image& image, const std::string& path) {
 }  // namespace
 
 void render_tip_png(const TriSurface& s, const std::string& path, const RenderOptions& options) {
-  const int w = options.panel_width_px, h = options.panel_height_px, header = 40, legend = 34;
+  const int w = options.panel_width_px, h = options.panel_height_px, header = 40, legend = 60;
   Image image(w, 2 * h + header + legend);
   TextWriter text(18), small(15);
   const std::array<unsigned char, 3> ink = {30, 30, 30};
@@ -167,14 +167,20 @@ void render_tip_png(const TriSurface& s, const std::string& path, const RenderOp
   small.draw(image, 12, header + 20, "from above (+y, groove side)", ink);
   draw_panel(s, options, Eigen::Vector3d(0.45, -0.75, 0.55), image, 0, header + h, w, h);
   small.draw(image, 12, header + h + 20, "from below (-y)", ink);
-  int x = 12;
-  const int y = header + 2 * h + 8;
-  for (const std::string& name : s.tag_names) {
+  // Legend: the tags that have triangles, wrapped to the image width.
+  std::vector<bool> present(s.tag_names.size(), false);
+  for (int f = 0; f < s.num_faces(); ++f) present[s.face_tag.size() ? s.face_tag(f) : 0] = true;
+  int x = 12, y = header + 2 * h + 6;
+  for (size_t t = 0; t < s.tag_names.size(); ++t) {
+    if (!present[t]) continue;
+    const std::string& name = s.tag_names[t];
+    const int item_width = 26 + 9 * static_cast<int>(name.size()) + 14;
+    if (x + item_width > w) x = 12, y += 26;
     const auto color = tag_color(name);
     for (int dy = 0; dy < 16; ++dy)
       for (int dx = 0; dx < 16; ++dx) image.set(x + dx, y + dy, color);
     small.draw(image, x + 21, y + 14, name, ink);
-    x += 26 + 9 * static_cast<int>(name.size()) + 14;
+    x += item_width;
   }
   const std::string scratch = scratch_dir_beside(path);
   const std::string name = std::filesystem::path(path).filename().string();

@@ -26,25 +26,9 @@ std::vector<double> rod_edge_angles(const TipGeometry& tip, const TessellationOp
   // Where two facets' common line pierces the cylinder on the solid's surface.
   const int n = static_cast<int>(tip.facets.size());
   for (int i = 0; i < n; ++i)
-    for (int j = i + 1; j < n; ++j) {
-      const Eigen::Vector3d& ni = tip.facets[i].normal;
-      const Eigen::Vector3d& nj = tip.facets[j].normal;
-      const Eigen::Vector3d dir = ni.cross(nj);
-      const double a = dir.y() * dir.y() + dir.z() * dir.z();
-      if (dir.norm() < 1e-12 || a < 1e-14) continue;
-      Eigen::Matrix3d M;
-      M << ni.transpose(), nj.transpose(), dir.transpose();
-      const Eigen::Vector3d p0 = M.inverse() * Eigen::Vector3d(ni.dot(tip.facets[i].point),
-                                                               nj.dot(tip.facets[j].point), 0.0);
-      const double b = 2.0 * (p0.y() * dir.y() + p0.z() * dir.z());
-      const double c = p0.y() * p0.y() + p0.z() * p0.z() - R * R;
-      const double disc = b * b - 4 * a * c;
-      if (disc < 0) continue;
-      for (double sign : {-1.0, 1.0}) {
-        const Eigen::Vector3d p = p0 + (-b + sign * std::sqrt(disc)) / (2 * a) * dir;
+    for (int j = i + 1; j < n; ++j)
+      for (const Eigen::Vector3d& p : plane_pair_on_cylinder(tip.facets[i], tip.facets[j], R))
         if (tip.contains(p, 1e-9)) special.push_back(wrap(std::atan2(p.z(), p.y())));
-      }
-    }
   std::sort(special.begin(), special.end());
   std::vector<double> corners;
   for (double angle : special)

@@ -38,22 +38,7 @@ std::vector<Eigen::Vector3d> distal_candidates(const std::vector<FacetPlane>& pl
     }
     for (int j = i + 1; j < n; ++j) {
       const Eigen::Vector3d& nj = planes[j].normal;
-      const Eigen::Vector3d dir = ni.cross(nj);
-      if (dir.norm() < 1e-12) continue;
-      Eigen::Matrix3d M;
-      M << ni.transpose(), nj.transpose(), dir.transpose();
-      const Eigen::Vector3d p0 =
-          M.fullPivLu().solve(Eigen::Vector3d(ni.dot(planes[i].point), nj.dot(planes[j].point), 0.0));
-      // |p0_yz + t dir_yz| = R
-      const double a = dir.y() * dir.y() + dir.z() * dir.z();
-      const double b = 2.0 * (p0.y() * dir.y() + p0.z() * dir.z());
-      const double c = p0.y() * p0.y() + p0.z() * p0.z() - radius * radius;
-      const double disc = b * b - 4 * a * c;
-      if (a > 1e-14 && disc >= 0.0) {
-        const double s = std::sqrt(disc);
-        candidates.push_back(p0 + (-b + s) / (2 * a) * dir);
-        candidates.push_back(p0 + (-b - s) / (2 * a) * dir);
-      }
+      for (const Eigen::Vector3d& p : plane_pair_on_cylinder(planes[i], planes[j], radius)) candidates.push_back(p);
       for (int k = j + 1; k < n; ++k) {
         const Eigen::Vector3d& nk = planes[k].normal;
         Eigen::Matrix3d T;
@@ -68,6 +53,23 @@ std::vector<Eigen::Vector3d> distal_candidates(const std::vector<FacetPlane>& pl
 }
 
 }  // namespace
+
+std::vector<Eigen::Vector3d> plane_pair_on_cylinder(const FacetPlane& a, const FacetPlane& b, double radius) {
+  const Eigen::Vector3d dir = a.normal.cross(b.normal);
+  const double qa = dir.y() * dir.y() + dir.z() * dir.z();
+  if (dir.norm() < 1e-12 || qa < 1e-14) return {};
+  Eigen::Matrix3d M;
+  M << a.normal.transpose(), b.normal.transpose(), dir.transpose();
+  const Eigen::Vector3d p0 =
+      M.fullPivLu().solve(Eigen::Vector3d(a.normal.dot(a.point), b.normal.dot(b.point), 0.0));
+  // |p0_yz + t dir_yz| = radius
+  const double qb = 2.0 * (p0.y() * dir.y() + p0.z() * dir.z());
+  const double qc = p0.y() * p0.y() + p0.z() * p0.z() - radius * radius;
+  const double disc = qb * qb - 4 * qa * qc;
+  if (disc < 0.0) return {};
+  const double root = std::sqrt(disc);
+  return {p0 + (-qb + root) / (2 * qa) * dir, p0 + (-qb - root) / (2 * qa) * dir};
+}
 
 Eigen::Vector3d facet_outward_normal(double tilt_deg, double rotation_deg) {
   const double t = deg_to_rad(tilt_deg), r = deg_to_rad(rotation_deg);

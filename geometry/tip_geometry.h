@@ -47,6 +47,9 @@ struct TipGeometry {
 
 Eigen::Vector3d facet_outward_normal(double tilt_deg, double rotation_deg);
 
+// Where the common line of two planes pierces the cylinder |(y,z)| = radius: zero or two points.
+std::vector<Eigen::Vector3d> plane_pair_on_cylinder(const FacetPlane& a, const FacetPlane& b, double radius);
+
 // Resolves the recipe: places every plane, finds the most distal point of the solid analytically
 // (the maximum of x over the convex tip region) and shifts the frame so that x(A) = 0.
 // Throws InputError if the recipe is invalid, the tip is blunt (no single most distal point) or the

@@ -44,7 +44,7 @@ TEST_CASE("exported files re-import closed, manifold, with the same area and vol
   for (const std::string name : {"tip.obj", "tip.glb"}) {
     const TriSurface back = read_surface((dir / name).string());
     const std::vector<double> original = area_by_tag_mm2(solid.surface), areas = area_by_tag_mm2(back);
-    for (const std::string& tag : {"top", "side_pos", "groove_floor", "symmetry"}) {
+    for (const char* tag : {"top", "side_pos", "groove_floor", "symmetry"}) {
       INFO(name << " " << tag);
       REQUIRE(back.tag_index(tag) >= 0);
       CHECK(areas[back.tag_index(tag)] == Approx(original[solid.surface.tag_index(tag)]).epsilon(1e-5));
