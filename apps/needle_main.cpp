@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <fmt/format.h>
 
+#include "apps/mesh_command.h"
 #include "apps/tip_command.h"
 #include "geometry/input_error.h"
 
@@ -10,6 +11,8 @@ int main(int argc, char** argv) {
   CLI::App app{"needle: design biopsy needle tips - grinding CAD, meshing and insertion simulation"};
   app.require_subcommand(1);
   needle::add_tip_command(app);
+  needle::add_mesh_command(app);
+  needle::add_particles_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/recipe_json.h"
+#include "apps/tip_source.h"
 #include "geometry/cad_solid.h"
 #include "geometry/input_error.h"
 #include "geometry/mesh_io.h"
@@ -20,12 +21,10 @@ namespace {
 using nlohmann::json;
 
 struct TipOptions {
-  std::string preset, recipe_file, analyze_file, out_file, png_file;
-  double d_a_mm = std::nan("");
-  MultiBevelAngles angles;
+  TipSource source;
+  std::string analyze_file, out_file, png_file;
   bool half = false, json_output = false, ascii_stl = false;
-  double rod_length_mm = std::nan(""), groove_start_mm = std::nan("");
-  double chord_tolerance_mm = std::nan(""), section_step_mm = 0.5;
+  double section_step_mm = 0.5;
 };
 
 json vec(const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); }
@@ -93,27 +92,6 @@ void print_table(const TipReport& r) {
   }
 }
 
-GrindingRecipe recipe_from_options(const TipOptions& o) {
-  const int sources = !o.preset.empty() + !std::isnan(o.d_a_mm) + !o.recipe_file.empty();
-  NEEDLE_REQUIRE(sources == 1, "say which tip: exactly one of --preset, --d-a or --recipe");
-  GrindingRecipe recipe;
-  if (!o.preset.empty()) recipe = preset_recipe(o.preset);
-  if (!o.recipe_file.empty()) recipe = read_recipe_file(o.recipe_file);
-  if (!std::isnan(o.rod_length_mm)) recipe.rod.length_mm = o.rod_length_mm;
-  if (!std::isnan(o.groove_start_mm)) {
-    NEEDLE_REQUIRE(recipe.groove.has_value() || !std::isnan(o.d_a_mm), "--groove-start-mm given but the recipe has no groove");
-  }
-  if (!std::isnan(o.d_a_mm)) {
-    Groove groove;
-    if (!std::isnan(o.groove_start_mm)) groove.start_behind_tip_mm = o.groove_start_mm;
-    recipe = multi_bevel_recipe(o.d_a_mm, o.angles, recipe.rod, groove);
-  } else if (!std::isnan(o.groove_start_mm)) {
-    recipe.groove->start_behind_tip_mm = o.groove_start_mm;
-  }
-  if (!std::isnan(o.chord_tolerance_mm)) recipe.tessellation.chord_tolerance_mm = o.chord_tolerance_mm;
-  return recipe;
-}
-
 void analyze_file(const TipOptions& o) {
   const TriSurface surface = read_surface(o.analyze_file);
   const Eigen::Vector3d tip = most_distal_point(surface);
@@ -145,12 +123,12 @@ void analyze_file(const TipOptions& o) {
 
 void run_tip(const TipOptions& o) {
   if (!o.analyze_file.empty()) {
-    NEEDLE_REQUIRE(o.preset.empty() && o.recipe_file.empty() && std::isnan(o.d_a_mm),
+    NEEDLE_REQUIRE(!o.source.given(),
                    "--analyze reads a tip from a file: do not combine it with --preset, --d-a or --recipe");
     analyze_file(o);
     return;
   }
-  const GrindingRecipe recipe = recipe_from_options(o);
+  const GrindingRecipe recipe = recipe_from_source(o.source);
   // Check output paths before any work, so a bad path costs nothing and writes nothing.
   SurfaceFormat format{};
   if (!o.out_file.empty()) format = surface_format_from_path(o.out_file, o.ascii_stl);
@@ -183,15 +161,7 @@ void run_tip(const TipOptions& o) {
 void add_tip_command(CLI::App& app) {
   auto options = std::make_shared<TipOptions>();
   CLI::App* tip = app.add_subcommand("tip", "Build a needle tip from a grinding recipe; report its numbers, export it, draw it");
-  tip->add_option("--preset", options->preset, "Paper tip: SB, LMB, AMB or HMB");
-  tip->add_option("--d-a", options->d_a_mm, "Multi-bevel tip with tip point A this far above the groove face (mm)");
-  tip->add_option("--recipe", options->recipe_file, "Grinding recipe JSON file (see docs/geometry.md)");
-  tip->add_option("--top-tilt-deg", options->angles.top_tilt_deg, "Multi-bevel: top bevel tilt")->capture_default_str();
-  tip->add_option("--bevel-tilt-deg", options->angles.bevel_tilt_deg, "Multi-bevel: bottom and side bevel tilt")->capture_default_str();
-  tip->add_option("--side-rotation-deg", options->angles.side_rotation_deg, "Multi-bevel: side bevel rotation (+/-)")->capture_default_str();
-  tip->add_option("--rod-length-mm", options->rod_length_mm, "Rod length from A to the base (default 40)");
-  tip->add_option("--groove-start-mm", options->groove_start_mm, "Groove front wall distance behind A (default 3)");
-  tip->add_option("--chord-tolerance-mm", options->chord_tolerance_mm, "Largest gap between the polygonal and the true rod (default 0.001)");
+  add_tip_source_options(*tip, options->source);
   tip->add_flag("--half", options->half, "Half model z >= 0 with the symmetry face tagged (for the solver)");
   tip->add_option("--out", options->out_file, "Write the surface: .stl .obj .ply .glb .gltf");
   tip->add_flag("--ascii", options->ascii_stl, "Write STL as ASCII instead of binary");

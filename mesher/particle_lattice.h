@@ -1,0 +1,60 @@
+#pragma once
+// Tissue particle sets for the SPG solver: a lattice filling a box, each particle with the volume of
+// its dual cell and boundary flags from the box face it lies on.
+//
+// The lattice is a tensor product: along each axis the box is split into equal intervals of about
+// spacing_mm (the count is rounded, the effective spacing reported), and an optional region of
+// interest is split `refinement` times finer. Particles sit on the lattice nodes, so the faces
+// (fixed faces, the symmetry plane) carry particles, as the nodes of a hexahedral mesh would.
+// A particle's volume is the product of its half-interval lengths; the volumes sum to the box
+// volume exactly.
+#include <Eigen/Dense>
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+
+namespace needle {
+
+enum class FaceCondition { free, fixed, symmetry };
+
+// Particle flags (bits): a particle on two faces carries both faces' flags.
+enum ParticleFlag : std::uint8_t { kParticleFixed = 1, kParticleSymmetry = 2, kParticleFreeSurface = 4 };
+
+struct TissueBox {
+  Eigen::Vector3d min_mm{0.0, -4.0, 0.0};  // the paper's 40 x 8 x 2 mm half block, needle path y = z = 0
+  Eigen::Vector3d max_mm{40.0, 4.0, 2.0};
+  // Faces in the order x_min, x_max, y_min, y_max, z_min, z_max. Paper: entry and back faces free,
+  // y = +-4 and z = 2 fixed, z = 0 symmetry.
+  std::array<FaceCondition, 6> faces{FaceCondition::free,  FaceCondition::free,     FaceCondition::fixed,
+                                     FaceCondition::fixed, FaceCondition::symmetry, FaceCondition::fixed};
+};
+
+struct RegionOfInterest {
+  Eigen::Vector3d min_mm, max_mm;  // snapped outward to the coarse lattice
+  int refinement = 2;              // fine spacing = spacing / refinement
+};
+
+struct LatticeOptions {
+  double spacing_mm = 0.4;
+  std::optional<RegionOfInterest> region_of_interest;
+};
+
+struct ParticleSet {
+  Eigen::MatrixX3d x_mm;                                // #P by 3 positions
+  Eigen::VectorXd volume_mm3;                           // #P dual-cell volumes
+  Eigen::VectorXd spacing_mm;                           // #P largest neighbouring interval (sets the support)
+  Eigen::Matrix<std::uint8_t, Eigen::Dynamic, 1> flags;  // #P ParticleFlag bits
+  Eigen::Vector3i nodes_per_axis{0, 0, 0};
+  int num_particles() const { return static_cast<int>(x_mm.rows()); }
+};
+
+// InputError for an empty box, a spacing that is not positive or leaves fewer than one interval
+// across an axis, a lattice over 5e7 particles, or a region of interest outside the box.
+ParticleSet make_particle_lattice(const TissueBox& box, const LatticeOptions& options);
+
+// Names as used in scene files and reports.
+FaceCondition face_condition_from_name(const std::string& name);
+std::string face_condition_name(FaceCondition condition);
+
+}  // namespace needle

@@ -1,0 +1,97 @@
+#include "mesher/tet_mesh.h"
+
+#include <algorithm>
+#include <map>
+#include <stdexcept>
+
+namespace needle {
+
+int TetMesh::tag_index(const std::string& name) const {
+  for (size_t i = 0; i < tag_names.size(); ++i)
+    if (tag_names[i] == name) return static_cast<int>(i);
+  return -1;
+}
+
+double signed_tet_volume(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                         const Eigen::Vector3d& d) {
+  return (b - a).cross(c - a).dot(d - a) / 6.0;
+}
+
+namespace {
+
+using FaceKey = std::array<int, 3>;
+
+FaceKey sorted_key(int a, int b, int c) {
+  FaceKey k{a, b, c};
+  std::sort(k.begin(), k.end());
+  return k;
+}
+
+// Swapping corners 1 and 2 reverses orientation; in VTK order the edge nodes follow as
+// (0,1)<->(0,2): 4<->6, (1,2) stays 5, (1,3)<->(2,3): 8<->9, (0,3) stays 7.
+void flip_tet(Eigen::MatrixXi& T, int t, int order) {
+  std::swap(T(t, 1), T(t, 2));
+  if (order == 2) {
+    std::swap(T(t, 4), T(t, 6));
+    std::swap(T(t, 8), T(t, 9));
+  }
+}
+
+// Reversing a triangle (swap corners 1 and 2): edge nodes (0,1)<->(2,0): 3<->5, (1,2) stays.
+void flip_face(Eigen::MatrixXi& F, int f, int order) {
+  std::swap(F(f, 1), F(f, 2));
+  if (order == 2) std::swap(F(f, 3), F(f, 5));
+}
+
+}  // namespace
+
+void orient_tet_mesh(TetMesh& mesh) {
+  auto corner = [&](int node) -> Eigen::Vector3d { return mesh.X.row(node).transpose(); };
+  std::map<FaceKey, int> opposite_corner;  // face -> the tet corner not on it
+  for (int t = 0; t < mesh.num_tets(); ++t) {
+    if (signed_tet_volume(corner(mesh.T(t, 0)), corner(mesh.T(t, 1)), corner(mesh.T(t, 2)), corner(mesh.T(t, 3))) < 0)
+      flip_tet(mesh.T, t, mesh.order);
+    for (int skip = 0; skip < 4; ++skip) {
+      int f[3], n = 0;
+      for (int c = 0; c < 4; ++c)
+        if (c != skip) f[n++] = mesh.T(t, c);
+      opposite_corner[sorted_key(f[0], f[1], f[2])] = mesh.T(t, skip);
+    }
+  }
+  for (int b = 0; b < mesh.num_boundary_faces(); ++b) {
+    const auto it = opposite_corner.find(sorted_key(mesh.boundary_faces(b, 0), mesh.boundary_faces(b, 1), mesh.boundary_faces(b, 2)));
+    if (it == opposite_corner.end()) {
+      int missing = 0;
+      for (int c = b; c < mesh.num_boundary_faces(); ++c)
+        missing += opposite_corner.count(sorted_key(mesh.boundary_faces(c, 0), mesh.boundary_faces(c, 1), mesh.boundary_faces(c, 2))) == 0;
+      throw std::runtime_error("mesh: " + std::to_string(missing) + " of " + std::to_string(mesh.num_boundary_faces()) +
+                               " boundary triangles are not faces of any tetrahedron (first tag " +
+                               std::to_string(mesh.boundary_tag(b)) + ", " + std::to_string(mesh.num_tets()) + " tets)");
+    }
+    const double v = signed_tet_volume(corner(mesh.boundary_faces(b, 0)), corner(mesh.boundary_faces(b, 1)),
+                                       corner(mesh.boundary_faces(b, 2)), corner(it->second));
+    if (v > 0) flip_face(mesh.boundary_faces, b, mesh.order);  // the inner corner must lie behind the face
+  }
+}
+
+void drop_unused_nodes(TetMesh& mesh) {
+  std::vector<int> new_index(mesh.num_nodes(), -1);
+  int used = 0;
+  for (int t = 0; t < mesh.num_tets(); ++t)
+    for (int c = 0; c < mesh.T.cols(); ++c)
+      if (new_index[mesh.T(t, c)] < 0) new_index[mesh.T(t, c)] = used++;
+  Eigen::MatrixX3d X(used, 3);
+  for (int i = 0; i < mesh.num_nodes(); ++i)
+    if (new_index[i] >= 0) X.row(new_index[i]) = mesh.X.row(i);
+  for (int t = 0; t < mesh.num_tets(); ++t)
+    for (int c = 0; c < mesh.T.cols(); ++c) mesh.T(t, c) = new_index[mesh.T(t, c)];
+  for (int b = 0; b < mesh.num_boundary_faces(); ++b)
+    for (int c = 0; c < mesh.boundary_faces.cols(); ++c) {
+      const int n = new_index[mesh.boundary_faces(b, c)];
+      if (n < 0) throw std::runtime_error("mesh: a boundary triangle uses a node no tetrahedron has");
+      mesh.boundary_faces(b, c) = n;
+    }
+  mesh.X = std::move(X);
+}
+
+}  // namespace needle

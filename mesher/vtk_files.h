@@ -1,0 +1,28 @@
+#pragma once
+// ParaView files in VTK's XML format (ASCII, so that a person can read them too): .vtu for tet meshes,
+// .vtp for particles. Each file appears complete or not at all.
+#include <Eigen/Dense>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "mesher/tet_mesh.h"
+
+namespace needle {
+
+// A named data array: #rows values with 1 (scalar) or 3 (vector) components.
+struct VtkField {
+  std::string name;
+  Eigen::MatrixXd values;  // #rows by 1 or 3
+};
+
+// Tets (VTK_TETRA / VTK_QUADRATIC_TETRA) followed by the boundary faces (VTK_TRIANGLE /
+// VTK_QUADRATIC_TRIANGLE). Cell data: `boundary_tag` (-1 on tets) plus tet_fields (given per tet,
+// written as 0 on the faces); point data: point_fields.
+void write_vtu(const std::string& path, const TetMesh& mesh, const std::vector<VtkField>& tet_fields = {},
+               const std::vector<VtkField>& point_fields = {});
+
+// Points as VTK_VERTEX cells with point data.
+void write_vtp(const std::string& path, const Eigen::MatrixX3d& points, const std::vector<VtkField>& point_fields = {});
+
+}  // namespace needle
