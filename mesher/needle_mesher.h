@@ -35,7 +35,10 @@ struct NeedleMeshOptions {
 TetMesh mesh_needle(const TipGeometry& tip, bool half_model, const NeedleMeshOptions& options);
 
 // Meshes the solid enclosed by a closed, manifold, outward surface. The surface's triangles become
-// the boundary faces and keep their tags; only size_mm, order, threads and optimize apply.
+// the boundary faces and keep their tags; only size_mm, order, threads and optimize apply. Uses gmsh's
+// HXT (the only 3D algorithm that refines a discrete volume), so tet counts vary slightly between runs.
+// The quality of the result is bounded by the quality of the given triangles: the CAD's own surface,
+// with its long shaft triangles, gives slivers (docs/mesher.md), which is why mesh_needle() is the default.
 TetMesh mesh_surface(const TriSurface& surface, const NeedleMeshOptions& options);
 
 }  // namespace needle

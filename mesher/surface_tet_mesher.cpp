@@ -47,9 +47,15 @@ TetMesh mesh_surface(const TriSurface& surface, const NeedleMeshOptions& options
     const int loop = gmsh::model::geo::addSurfaceLoop({1});
     gmsh::model::geo::addVolume({loop});
     gmsh::model::geo::synchronize();
-    gmsh::option::setNumber("Mesh.Algorithm3D", o.threads == 1 ? 1 : 10);
+    // HXT: gmsh's Delaunay (1) does not refine the interior of a discrete volume toward the size field.
+    gmsh::option::setNumber("Mesh.Algorithm3D", 10);
     gmsh::option::setNumber("Mesh.Optimize", o.optimize ? 1 : 0);
     gmsh::option::setNumber("Mesh.MeshSizeMax", o.size_mm);
+    gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", 0);
+    // Without a size field the interior takes the boundary triangles' sizes, however large.
+    const int size_field = gmsh::model::mesh::field::add("MathEval");
+    gmsh::model::mesh::field::setString(size_field, "F", fmt::format("{:.9g}", o.size_mm));
+    gmsh::model::mesh::field::setAsBackgroundMesh(size_field);
     gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
     gmsh::model::mesh::generate(3);
     if (o.order == 2) {
@@ -65,7 +71,7 @@ TetMesh mesh_surface(const TriSurface& surface, const NeedleMeshOptions& options
     const std::string what = e.what();
     if (what.find("PLC Error") == std::string::npos) throw;
     throw InputError("the surface cannot be filled with tets: its triangles intersect or nearly touch (" + what +
-                     "). Remesh it, or try gmsh's HXT with --threads 2, which tolerates more but makes slivers");
+                     "). Remesh it with well-shaped triangles");
   }
   if (mesh.num_tets() == 0) throw std::runtime_error("mesher: gmsh produced no tetrahedra inside the surface");
   // Node i of the mesh need not be vertex i of the surface: match corner positions, then tags.

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The main job today: build the paper's four tips, write their reports (JSON), surfaces (STL, glb)
-# and pictures (PNG) into out/, and print the speed-against-error benchmark.
+# and pictures (PNG), their half-model T10 meshes (MSH, VTU) and the tissue particles (VTP) into out/,
+# and print the speed-against-error benchmarks.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh
@@ -8,6 +9,11 @@ mkdir -p out
 for preset in SB LMB AMB HMB; do
   ./build/apps/needle tip --preset "$preset" --json --out "out/$preset.stl" > "out/$preset.json"
   ./build/apps/needle tip --preset "$preset" --half --out "out/${preset}_half.glb" --png "out/$preset.png"
+  ./build/apps/needle mesh --preset "$preset" --order 2 --size-mm 0.2 --half \
+    --out "out/${preset}_half_t10.msh" --out "out/${preset}_half_t10.vtu" --json > "out/${preset}_mesh.json"
 done
+./build/apps/needle particles --preset SB --insert-mm 5 --out out/tissue_particles.vtp --json > out/tissue_particles.json
 ./build/bench/bench_tip 3 | tee out/bench_tip.txt
-echo "results in out/: <preset>.json (report), <preset>.stl, <preset>_half.glb, <preset>.png"
+./build/bench/bench_mesh | tee out/bench_mesh.txt
+echo "results in out/: <preset>.json (report), <preset>.stl, <preset>_half.glb, <preset>.png,"
+echo "  <preset>_half_t10.msh/.vtu + <preset>_mesh.json (T10 mesh and its report), tissue_particles.vtp/.json"
