@@ -69,14 +69,9 @@ void run_mesh(MeshCommandOptions& o) {
     report["route"] = "surface";
   } else {
     const GrindingRecipe recipe = recipe_from_source(o.source);
-    if (o.route == "exact") {
-      const TipGeometry tip = resolve_tip(recipe);
-      mesh = mesh_needle(tip, o.half, resolved);
-    } else {
-      const CadSolid solid = build_cad_solid(recipe, o.half);
-      mesh = mesh_surface(solid.surface, resolved);
-    }
     const TipGeometry tip = resolve_tip(recipe);
+    mesh = o.route == "exact" ? mesh_needle(tip, o.half, resolved)
+                              : mesh_surface(build_cad_solid(recipe, o.half).surface, resolved);
     ExactOptions exact;
     exact.half_model = o.half;
     cad_volume = exact_volume_mm3(tip, exact);

@@ -76,11 +76,9 @@ void run_particles(const ParticlesOptions& o) {
     const NeedleLevelSet level_set(solid.surface, o.level_set);
     const Eigen::Vector3d offset(box.min_mm.x() + o.insert_mm, 0, 0);  // tip point A this far into the block
     const PenetrationReport inside = find_penetrations(level_set, particles.x_mm, offset);
-    Eigen::VectorXd distance(n), in(n);
-    for (Eigen::Index i = 0; i < n; ++i) distance[i] = level_set.signed_distance_mm(particles.x_mm.row(i).transpose() - offset);
-    in.setZero();
+    Eigen::VectorXd in = Eigen::VectorXd::Zero(n);
     for (int i : inside.inside) in[i] = 1.0;
-    fields.push_back({"needle_distance_mm", distance});
+    fields.push_back({"needle_distance_mm", inside.signed_distance_mm});
     fields.push_back({"inside_needle", in});
     report["needle"] = {{"source", solid.tip.name},
                         {"tip_point_x_mm", offset.x()},

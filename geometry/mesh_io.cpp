@@ -42,6 +42,19 @@ void commit_scratch_file(const std::string& scratch_dir, const std::string& name
   fs::rename(fs::path(scratch_dir) / name, fs::path(final_dir.empty() ? "." : final_dir) / name);
 }
 
+void write_file_atomically(const std::string& path, const std::function<void(const std::string& scratch_path)>& write) {
+  const std::string scratch = scratch_dir_beside(path);
+  try {
+    const std::string name = fs::path(path).filename().string();
+    write((fs::path(scratch) / name).string());
+    commit_scratch_file(scratch, name, fs::path(path).parent_path().string());
+  } catch (...) {
+    fs::remove_all(scratch);
+    throw;
+  }
+  fs::remove_all(scratch);
+}
+
 namespace {
 
 // One aiMesh per group of faces; the scene owns everything it points to.

@@ -1,6 +1,7 @@
 #pragma once
 // Surface files through assimp: STL (binary, ASCII), OBJ (+ .mtl), PLY, glTF 2 (.glb, .gltf + .bin).
 // OBJ and glTF keep one mesh per facet tag, named after it, so the tags survive the round trip.
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -24,5 +25,9 @@ TriSurface read_surface(const std::string& path);
 // Small helpers for apps that write other files the same all-or-nothing way.
 std::string scratch_dir_beside(const std::string& path);
 void commit_scratch_file(const std::string& scratch_dir, const std::string& name, const std::string& final_dir);
+
+// Calls write(scratch_path) to write one file in a scratch folder beside `path`, then renames it to
+// `path`; if write throws, nothing is left behind.
+void write_file_atomically(const std::string& path, const std::function<void(const std::string& scratch_path)>& write);
 
 }  // namespace needle

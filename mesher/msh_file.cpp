@@ -16,22 +16,15 @@ namespace needle {
 void write_msh(const TetMesh& mesh, const std::string& path) {
   namespace fs = std::filesystem;
   NEEDLE_REQUIRE(fs::path(path).extension() == ".msh", fmt::format("'{}': a gmsh mesh file must end in .msh", path));
-  const std::string scratch = scratch_dir_beside(path);
-  try {
+  write_file_atomically(path, [&](const std::string& scratch_path) {
     detail::GmshSession session("needle");
     detail::gmsh_call("writing " + path, [&] {
       detail::load_tet_mesh(mesh);
       gmsh::option::setNumber("Mesh.MshFileVersion", 4.1);
       gmsh::option::setNumber("Mesh.Binary", 0);
-      gmsh::write((fs::path(scratch) / fs::path(path).filename()).string());
+      gmsh::write(scratch_path);
     });
-    const fs::path parent = fs::path(path).parent_path();
-    commit_scratch_file(scratch, fs::path(path).filename().string(), parent.empty() ? "." : parent.string());
-  } catch (...) {
-    fs::remove_all(scratch);
-    throw;
-  }
-  fs::remove_all(scratch);
+  });
 }
 
 TetMesh read_msh(const std::string& path) {

@@ -79,8 +79,10 @@ double NeedleLevelSet::build_seconds() const { return impl_->seconds; }
 PenetrationReport find_penetrations(const NeedleLevelSet& needle, const Eigen::MatrixX3d& points,
                                     const Eigen::Vector3d& needle_offset_mm) {
   PenetrationReport report;
+  report.signed_distance_mm.resize(points.rows());
   for (Eigen::Index i = 0; i < points.rows(); ++i) {
     const double d = needle.signed_distance_mm(points.row(i).transpose() - needle_offset_mm);
+    report.signed_distance_mm[i] = d;
     if (d < 0) {
       report.inside.push_back(static_cast<int>(i));
       report.max_depth_mm = std::max(report.max_depth_mm, -d);

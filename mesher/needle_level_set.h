@@ -47,6 +47,7 @@ class NeedleLevelSet {
 
 // Points inside the needle when the needle is moved by `needle_offset_mm`.
 struct PenetrationReport {
+  Eigen::VectorXd signed_distance_mm;  // per point, as signed_distance_mm() returns it
   std::vector<int> inside;        // indices of points inside the needle
   double max_depth_mm = 0;        // deepest point below the needle surface, at most the band width
   bool depth_saturated = false;   // some point lies deeper than the band: max_depth_mm is a lower bound

@@ -29,44 +29,44 @@ TetMesh mesh_surface(const TriSurface& surface, const NeedleMeshOptions& options
   detail::GmshSession session("surface", o.threads);
   TetMesh mesh;
   try {
-  detail::gmsh_call("meshing the surface", [&] {
-    // One discrete surface holding every triangle (gmsh keeps its mesh as given), closed by a geo
-    // volume; the tags come back afterwards by matching the unchanged boundary triangles.
-    gmsh::model::addDiscreteEntity(2, 1);
-    std::vector<std::size_t> node_tags(static_cast<size_t>(surface.num_vertices()));
-    std::iota(node_tags.begin(), node_tags.end(), std::size_t{1});
-    std::vector<double> coords(3 * node_tags.size());
-    for (int v = 0; v < surface.num_vertices(); ++v)
-      for (int k = 0; k < 3; ++k) coords[static_cast<size_t>(3 * v + k)] = surface.V(v, k);
-    gmsh::model::mesh::addNodes(2, 1, node_tags, coords);
-    std::vector<std::size_t> face_tags(static_cast<size_t>(surface.num_faces())), face_nodes;
-    std::iota(face_tags.begin(), face_tags.end(), std::size_t{1});
-    for (int f = 0; f < surface.num_faces(); ++f)
-      for (int c = 0; c < 3; ++c) face_nodes.push_back(static_cast<std::size_t>(surface.F(f, c)) + 1);
-    gmsh::model::mesh::addElementsByType(1, 2, face_tags, face_nodes);
-    const int loop = gmsh::model::geo::addSurfaceLoop({1});
-    gmsh::model::geo::addVolume({loop});
-    gmsh::model::geo::synchronize();
-    // HXT: gmsh's Delaunay (1) does not refine the interior of a discrete volume toward the size field.
-    gmsh::option::setNumber("Mesh.Algorithm3D", 10);
-    gmsh::option::setNumber("Mesh.Optimize", o.optimize ? 1 : 0);
-    gmsh::option::setNumber("Mesh.MeshSizeMax", o.size_mm);
-    gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", 0);
-    // Without a size field the interior takes the boundary triangles' sizes, however large.
-    const int size_field = gmsh::model::mesh::field::add("MathEval");
-    gmsh::model::mesh::field::setString(size_field, "F", fmt::format("{:.9g}", o.size_mm));
-    gmsh::model::mesh::field::setAsBackgroundMesh(size_field);
-    gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
-    gmsh::model::mesh::generate(3);
-    if (o.order == 2) {
-      // No exact geometry behind a discrete surface: mid-edge nodes stay on its flat triangles.
-      gmsh::option::setNumber("Mesh.SecondOrderLinear", 1);
-      gmsh::model::mesh::setOrder(2);
-    }
-    std::vector<std::string> names = surface.tag_names;
-    if (names.empty()) names = {"surface"};
-    mesh = detail::extract_tet_mesh(o.order, {{1, 0}}, names);
-  });
+    detail::gmsh_call("meshing the surface", [&] {
+      // One discrete surface holding every triangle (gmsh keeps its mesh as given), closed by a geo
+      // volume; the tags come back afterwards by matching the unchanged boundary triangles.
+      gmsh::model::addDiscreteEntity(2, 1);
+      std::vector<std::size_t> node_tags(static_cast<size_t>(surface.num_vertices()));
+      std::iota(node_tags.begin(), node_tags.end(), std::size_t{1});
+      std::vector<double> coords(3 * node_tags.size());
+      for (int v = 0; v < surface.num_vertices(); ++v)
+        for (int k = 0; k < 3; ++k) coords[static_cast<size_t>(3 * v + k)] = surface.V(v, k);
+      gmsh::model::mesh::addNodes(2, 1, node_tags, coords);
+      std::vector<std::size_t> face_tags(static_cast<size_t>(surface.num_faces())), face_nodes;
+      std::iota(face_tags.begin(), face_tags.end(), std::size_t{1});
+      for (int f = 0; f < surface.num_faces(); ++f)
+        for (int c = 0; c < 3; ++c) face_nodes.push_back(static_cast<std::size_t>(surface.F(f, c)) + 1);
+      gmsh::model::mesh::addElementsByType(1, 2, face_tags, face_nodes);
+      const int loop = gmsh::model::geo::addSurfaceLoop({1});
+      gmsh::model::geo::addVolume({loop});
+      gmsh::model::geo::synchronize();
+      // HXT: gmsh's Delaunay (1) does not refine the interior of a discrete volume toward the size field.
+      gmsh::option::setNumber("Mesh.Algorithm3D", 10);
+      gmsh::option::setNumber("Mesh.Optimize", o.optimize ? 1 : 0);
+      gmsh::option::setNumber("Mesh.MeshSizeMax", o.size_mm);
+      gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", 0);
+      // Without a size field the interior takes the boundary triangles' sizes, however large.
+      const int size_field = gmsh::model::mesh::field::add("MathEval");
+      gmsh::model::mesh::field::setString(size_field, "F", fmt::format("{:.9g}", o.size_mm));
+      gmsh::model::mesh::field::setAsBackgroundMesh(size_field);
+      gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
+      gmsh::model::mesh::generate(3);
+      if (o.order == 2) {
+        // No exact geometry behind a discrete surface: mid-edge nodes stay on its flat triangles.
+        gmsh::option::setNumber("Mesh.SecondOrderLinear", 1);
+        gmsh::model::mesh::setOrder(2);
+      }
+      std::vector<std::string> names = surface.tag_names;
+      if (names.empty()) names = {"surface"};
+      mesh = detail::extract_tet_mesh(o.order, {{1, 0}}, names);
+    });
   } catch (const std::runtime_error& e) {
     const std::string what = e.what();
     if (what.find("PLC Error") == std::string::npos) throw;

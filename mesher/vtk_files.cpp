@@ -13,25 +13,16 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Writes through a scratch file that is renamed into place once complete.
+// Writes a text file through a scratch file that is renamed into place once complete.
 template <class Body>
 void write_atomically(const std::string& path, const std::string& extension, Body body) {
   NEEDLE_REQUIRE(fs::path(path).extension() == extension, fmt::format("'{}' must end in {}", path, extension));
-  const std::string scratch = scratch_dir_beside(path);
-  try {
-    {
-      std::ofstream out(fs::path(scratch) / fs::path(path).filename());
-      out.precision(17);
-      body(out);
-      if (!out) throw std::runtime_error("could not write " + path);
-    }
-    const fs::path parent = fs::path(path).parent_path();
-    commit_scratch_file(scratch, fs::path(path).filename().string(), parent.empty() ? "." : parent.string());
-  } catch (...) {
-    fs::remove_all(scratch);
-    throw;
-  }
-  fs::remove_all(scratch);
+  write_file_atomically(path, [&](const std::string& scratch_path) {
+    std::ofstream out(scratch_path);
+    out.precision(17);
+    body(out);
+    if (!out) throw std::runtime_error("could not write " + path);
+  });
 }
 
 void write_array(std::ostream& out, const std::string& type, const std::string& name, int components,

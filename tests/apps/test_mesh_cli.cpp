@@ -1,33 +1,16 @@
 // `needle mesh` and `needle particles` end to end, as a user runs them.
 #include <catch2/catch.hpp>
-#include <array>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <sys/wait.h>
+#include "cli_run.h"
 
 #include "mesher/msh_file.h"
 
 namespace fs = std::filesystem;
 
-namespace {
-struct Result {
-  int exit_code;
-  std::string out;
-};
-Result run(const std::string& args) {
-  const std::string command = std::string(NEEDLE_BINARY) + " " + args + " 2>/dev/null";
-  FILE* pipe = popen(command.c_str(), "r");
-  REQUIRE(pipe);
-  std::string out;
-  std::array<char, 4096> buffer;
-  size_t n;
-  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) out.append(buffer.data(), n);
-  const int status = pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
-}  // namespace
+using needle_test::Result;
+using needle_test::run;
 
 TEST_CASE("needle mesh --preset LMB --order 2 --size-mm 0.2 --half writes a valid T10 mesh", "[apps][cli][mesher]") {
   const fs::path dir = fs::temp_directory_path() / "needle-mesh-cli-test";

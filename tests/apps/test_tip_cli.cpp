@@ -1,30 +1,13 @@
 // `needle tip` end to end, as a user runs it: exit codes, JSON fields, files written or not.
 #include <catch2/catch.hpp>
-#include <array>
-#include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
-#include <sys/wait.h>
+#include "cli_run.h"
 
 namespace fs = std::filesystem;
 
-namespace {
-struct Result {
-  int exit_code;
-  std::string out;
-};
-Result run(const std::string& args) {
-  const std::string command = std::string(NEEDLE_BINARY) + " " + args + " 2>/dev/null";
-  FILE* pipe = popen(command.c_str(), "r");
-  REQUIRE(pipe);
-  std::string out;
-  std::array<char, 4096> buffer;
-  size_t n;
-  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) out.append(buffer.data(), n);
-  const int status = pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
-}  // namespace
+using needle_test::Result;
+using needle_test::run;
 
 TEST_CASE("needle tip --preset LMB --json prints the report", "[apps][cli]") {
   const Result r = run("tip --preset LMB --json");
