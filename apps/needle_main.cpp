@@ -3,9 +3,11 @@
 #include <cstdio>
 #include <fmt/format.h>
 
+#include "apps/material_test_command.h"
 #include "apps/mesh_command.h"
 #include "apps/tip_command.h"
 #include "geometry/input_error.h"
+#include "solver/solver_error.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"needle: design biopsy needle tips - grinding CAD, meshing and insertion simulation"};
@@ -13,6 +15,7 @@ int main(int argc, char** argv) {
   needle::add_tip_command(app);
   needle::add_mesh_command(app);
   needle::add_particles_command(app);
+  needle::add_material_test_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -20,6 +23,9 @@ int main(int argc, char** argv) {
   } catch (const needle::InputError& e) {
     fmt::print(stderr, "needle: error: {}\n", e.what());
     return 2;
+  } catch (const needle::SolverError& e) {
+    fmt::print(stderr, "needle: the solver stopped: {}\n", e.what());
+    return 3;
   } catch (const std::exception& e) {
     fmt::print(stderr, "needle: failed: {}\n", e.what());
     return 1;

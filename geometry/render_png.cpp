@@ -1,9 +1,5 @@
 #include "geometry/render_png.h"
 
-#include <ft2build.h>
-#include FT_FREETYPE_H
-#include <png.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -15,62 +11,13 @@
 #include "geometry/input_error.h"
 #include "geometry/mesh_io.h"
 #include "geometry/tag_colors.h"
+#include "plot/raster_image.h"
 
 namespace needle {
 namespace {
 
-struct Image {
-  int width, height;
-  std::vector<unsigned char> rgb;
-  Image(int w, int h) : width(w), height(h), rgb(3 * w * h, 255) {}
-  void set(int x, int y, const std::array<unsigned char, 3>& c) {
-    if (x < 0 || y < 0 || x >= width || y >= height) return;
-    std::copy(c.begin(), c.end(), rgb.begin() + 3 * (y * width + x));
-  }
-  void blend(int x, int y, const std::array<unsigned char, 3>& c, double alpha) {
-    if (x < 0 || y < 0 || x >= width || y >= height) return;
-    for (int k = 0; k < 3; ++k) {
-      unsigned char& p = rgb[3 * (y * width + x) + k];
-      p = static_cast<unsigned char>(std::lround(p * (1 - alpha) + c[k] * alpha));
-    }
-  }
-};
-
-// Text through FreeType with the DejaVu font Debian ships; silently no text if the font is absent.
-class TextWriter {
- public:
-  explicit TextWriter(int pixel_size) {
-    if (FT_Init_FreeType(&library_)) return;
-    for (const char* font : {"/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
-                             "/usr/share/fonts/TTF/DejaVuSans.ttf"})
-      if (!FT_New_Face(library_, font, 0, &face_)) break;
-    if (face_) FT_Set_Pixel_Sizes(face_, 0, pixel_size);
-  }
-  ~TextWriter() {
-    if (face_) FT_Done_Face(face_);
-    if (library_) FT_Done_FreeType(library_);
-  }
-  void draw(Image& image, int x, int baseline, const std::string& text, const std::array<unsigned char, 3>& color) {
-    if (!face_) return;
-    for (char c : text) {
-      if (FT_Load_Char(face_, static_cast<unsigned char>(c), FT_LOAD_RENDER)) continue;
-      const FT_GlyphSlot g = face_->glyph;
-      for (unsigned row = 0; row < g->bitmap.rows; ++row)
-        for (unsigned col = 0; col < g->bitmap.width; ++col) {
-          const double alpha = g->bitmap.buffer[row * g->bitmap.pitch + col] / 255.0;
-          if (alpha > 0) image.blend(x + g->bitmap_left + col, baseline - g->bitmap_top + row, color, alpha);
-        }
-      x += g->advance.x >> 6;
-    }
-  }
-
- private:
-  FT_Library library_ = nullptr;
-  FT_Face face_ = nullptr;
-};
-
 // Orthographic view along -eye, the needle axis kept horizontal on screen.
-void draw_panel(const TriSurface& s, const RenderOptions& options, const Eigen::Vector3d& eye_dir, Image& image,
+void draw_panel(const TriSurface& s, const RenderOptions& options, const Eigen::Vector3d& eye_dir, RgbImage& image,
                 int x0, int y0, int w, int h) {
   const Eigen::Vector3d eye = eye_dir.normalized();
   Eigen::Vector3d right = Eigen::Vector3d::UnitX() - eye.x() * eye;
@@ -134,32 +81,11 @@ void draw_panel(const TriSurface& s, const RenderOptions& options, const Eigen::
   }
 }
 
-void write_png(const Image& image, const std::string& path) {
-  FILE* file = std::fopen(path.c_str(), "wb");
-  if (!file) throw std::runtime_error(fmt::format("cannot open '{}' for writing", path));
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
-  png_infop info = png_create_info_struct(png);
-  if (setjmp(png_jmpbuf(png))) {
-    png_destroy_write_struct(&png, &info);
-    std::fclose(file);
-    throw std::runtime_error(fmt::format("libpng failed writing '{}'", path));
-  }
-  png_init_io(png, file);
-  png_set_IHDR(png, info, image.width, image.height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
-               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-  png_write_info(png, info);
-  for (int y = 0; y < image.height; ++y)
-    png_write_row(png, const_cast<png_bytep>(image.rgb.data() + 3 * y * image.width));
-  png_write_end(png, nullptr);
-  png_destroy_write_struct(&png, &info);
-  std::fclose(file);
-}
-
 }  // namespace
 
 void render_tip_png(const TriSurface& s, const std::string& path, const RenderOptions& options) {
   const int w = options.panel_width_px, h = options.panel_height_px, header = 40, legend = 60;
-  Image image(w, 2 * h + header + legend);
+  RgbImage image(w, 2 * h + header + legend);
   TextWriter text(18), small(15);
   const std::array<unsigned char, 3> ink = {30, 30, 30};
   text.draw(image, 12, 27, options.title, ink);
@@ -182,16 +108,7 @@ void render_tip_png(const TriSurface& s, const std::string& path, const RenderOp
     small.draw(image, x + 21, y + 14, name, ink);
     x += item_width;
   }
-  const std::string scratch = scratch_dir_beside(path);
-  const std::string name = std::filesystem::path(path).filename().string();
-  try {
-    write_png(image, (std::filesystem::path(scratch) / name).string());
-    commit_scratch_file(scratch, name, std::filesystem::path(path).parent_path().string());
-  } catch (...) {
-    std::filesystem::remove_all(scratch);
-    throw;
-  }
-  std::filesystem::remove_all(scratch);
+  write_file_atomically(path, [&](const std::string& scratch_path) { write_png(image, scratch_path); });
 }
 
 }  // namespace needle

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The main job today: build the paper's four tips, write their reports (JSON), surfaces (STL, glb)
-# and pictures (PNG), their half-model T10 meshes (MSH, VTU) and the tissue particles (VTP) into out/,
-# and print the speed-against-error benchmarks.
+# and pictures (PNG), their half-model T10 meshes (MSH, VTU), the tissue particles (VTP) and the
+# tissue card's uniaxial test (CSV, PNG, JSON) into out/, and print the speed-against-error benchmarks.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh
@@ -13,7 +13,11 @@ for preset in SB LMB AMB HMB; do
     --out "out/${preset}_half_t10.msh" --out "out/${preset}_half_t10.vtu" --json > "out/${preset}_mesh.json"
 done
 ./build/apps/needle particles --preset SB --insert-mm 5 --out out/tissue_particles.vtp --json > out/tissue_particles.json
+./build/apps/needle material-test --csv out/material_test.csv --png out/material_test.png
+./build/apps/needle material-test --json > out/material_test.json
 ./build/bench/bench_tip 3 | tee out/bench_tip.txt
 ./build/bench/bench_mesh | tee out/bench_mesh.txt
+./build/bench/bench_spg | tee out/bench_spg.txt
 echo "results in out/: <preset>.json (report), <preset>.stl, <preset>_half.glb, <preset>.png,"
-echo "  <preset>_half_t10.msh/.vtu + <preset>_mesh.json (T10 mesh and its report), tissue_particles.vtp/.json"
+echo "  <preset>_half_t10.msh/.vtu + <preset>_mesh.json (T10 mesh and its report), tissue_particles.vtp/.json,"
+echo "  material_test.csv/.png/.json (the tissue card in uniaxial tension), bench_*.txt"

@@ -1,0 +1,43 @@
+#include "apps/material_json.h"
+
+#include <fstream>
+
+#include "apps/json_object_reader.h"
+
+namespace needle {
+
+TissueMaterial material_from_json(const nlohmann::json& json, const std::string& source, const TissueMaterial& defaults) {
+  ObjectReader reader(json, "material", source);
+  TissueMaterial m = defaults;
+  m.E_MPa = reader.number("E_MPa", m.E_MPa);
+  m.nu = reader.number("nu", m.nu);
+  m.density_g_per_cm3 = reader.number("density_g_per_cm3", m.density_g_per_cm3);
+  m.k_MPa = reader.number("k_MPa", m.k_MPa);
+  m.n = reader.number("n", m.n);
+  m.rate_law = rate_law_from_name(reader.text("rate_law", rate_law_name(m.rate_law)));
+  m.rate_C_per_ms = reader.number("rate_C_per_ms", m.rate_C_per_ms);
+  m.rate_p = reader.number("rate_p", m.rate_p);
+  m.max_rate_factor = reader.number("max_rate_factor", m.max_rate_factor);
+  reader.finish();
+  return m;
+}
+
+TissueMaterial read_material_file(const std::string& path) {
+  std::ifstream in(path);
+  NEEDLE_REQUIRE(in, fmt::format("cannot read material file '{}'", path));
+  nlohmann::json json;
+  try {
+    in >> json;
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(fmt::format("{}: not valid JSON ({})", path, e.what()));
+  }
+  return material_from_json(json, path);
+}
+
+nlohmann::json material_to_json(const TissueMaterial& m) {
+  return {{"E_MPa", m.E_MPa}, {"nu", m.nu}, {"density_g_per_cm3", m.density_g_per_cm3}, {"k_MPa", m.k_MPa}, {"n", m.n},
+          {"rate_law", rate_law_name(m.rate_law)}, {"rate_C_per_ms", m.rate_C_per_ms}, {"rate_p", m.rate_p},
+          {"max_rate_factor", m.max_rate_factor}};
+}
+
+}  // namespace needle

@@ -1,0 +1,26 @@
+#pragma once
+// Bonds: the particle pairs that interact, i.e. j in the support covering i or i in the support covering
+// j. A bond names its (up to two) shape-function entries; breaking it cuts both, so the pair leaves each
+// other's supports and the rows are rebuilt without it.
+#include <cstdint>
+#include <vector>
+
+#include "solver/rk_shape_functions.h"
+
+namespace needle {
+
+struct Bond {
+  std::int32_t i, j;          // i < j
+  std::int64_t entry_ij = -1;  // entry of centre j in row i (-1: none)
+  std::int64_t entry_ji = -1;  // entry of centre i in row j
+  bool broken = false;
+};
+
+struct BondNetwork {
+  std::vector<Bond> bonds;
+  std::int64_t broken_count = 0;
+};
+
+BondNetwork build_bond_network(const RkShapeFunctions& rk);
+
+}  // namespace needle

@@ -1,0 +1,144 @@
+#include "solver/explicit_dynamics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+
+#include "geometry/input_error.h"
+#include "solver/parallel.h"
+#include "solver/solver_error.h"
+
+namespace needle {
+
+double EnergyBalance::relative_error() const {
+  const double residual = kinetic_mJ - initial_kinetic_mJ - model_work_mJ - body_work_mJ - constraint_work_mJ;
+  const double scale = std::max({std::abs(kinetic_mJ), std::abs(initial_kinetic_mJ), std::abs(model_work_mJ),
+                                 std::abs(body_work_mJ), std::abs(constraint_work_mJ), 1e-300});
+  return std::abs(residual) / scale;
+}
+
+TissueDynamics::TissueDynamics(SpgTissue& tissue, std::vector<VelocityConstraint> constraints,
+                               const Eigen::Vector3d& body_acceleration)
+    : tissue_(tissue), constraints_(std::move(constraints)), body_acceleration_(body_acceleration) {
+  const TissueParticles& p = tissue_.particles();
+  for (const VelocityConstraint& c : constraints_) {
+    NEEDLE_REQUIRE(c.axis >= 0 && c.axis < 3, "velocity constraint axis must be 0, 1 or 2");
+    NEEDLE_REQUIRE(static_cast<bool>(c.velocity_mm_per_ms), "velocity constraint without a velocity function");
+    NEEDLE_REQUIRE(c.scale.empty() || c.scale.size() == c.particles.size(), "velocity constraint scale needs one value per particle");
+    for (std::int32_t i : c.particles) NEEDLE_REQUIRE(i >= 0 && i < p.size(), "velocity constraint names a particle that does not exist");
+  }
+  NEEDLE_REQUIRE(body_acceleration.allFinite(), "body acceleration must be finite");
+  constrained_mask_.assign(static_cast<size_t>(p.size()), 0);
+  for (std::int64_t i = 0; i < p.size(); ++i) {
+    const std::uint8_t f = p.flags[static_cast<size_t>(i)];
+    if (f & kParticleFixed) constrained_mask_[static_cast<size_t>(i)] = 7;
+    else if (f & kParticleSymmetry) constrained_mask_[static_cast<size_t>(i)] |= 4;
+  }
+  for (const VelocityConstraint& c : constraints_)
+    for (std::int32_t i : c.particles) constrained_mask_[static_cast<size_t>(i)] |= static_cast<std::uint8_t>(1 << c.axis);
+  for (std::int64_t i = 0; i < p.size(); ++i)
+    if (constrained_mask_[static_cast<size_t>(i)]) constrained_.push_back(static_cast<std::int32_t>(i));
+  tissue_.compute_forces(0.0);
+  acceleration_.resize(static_cast<size_t>(p.size()));
+  for (std::int64_t i = 0; i < p.size(); ++i)
+    acceleration_[static_cast<size_t>(i)] = p.force_N[static_cast<size_t>(i)] / p.mass_g[static_cast<size_t>(i)] + body_acceleration_;
+  apply_constraints(tissue_.particles().velocity_mm_per_ms, 0.0);
+  energy_.initial_kinetic_mJ = energy_.kinetic_mJ = kinetic_energy_mJ();
+}
+
+void TissueDynamics::apply_constraints(std::vector<Vec3d>& v, double time_ms) {
+  const TissueParticles& p = tissue_.particles();
+  for (std::int64_t i = 0; i < p.size(); ++i) {
+    const std::uint8_t f = p.flags[static_cast<size_t>(i)];
+    if (f & kParticleFixed) v[static_cast<size_t>(i)].setZero();
+    else if (f & kParticleSymmetry) v[static_cast<size_t>(i)].z() = 0.0;
+  }
+  for (const VelocityConstraint& c : constraints_) {
+    const double value = c.velocity_mm_per_ms(time_ms);
+    for (size_t k = 0; k < c.particles.size(); ++k)
+      v[static_cast<size_t>(c.particles[k])][c.axis] = c.scale.empty() ? value : value * c.scale[k];
+  }
+}
+
+double TissueDynamics::kinetic_energy_mJ() const {
+  const TissueParticles& p = tissue_.particles();
+  double ke = 0;
+  for (std::int64_t i = 0; i < p.size(); ++i)
+    ke += 0.5 * p.mass_g[static_cast<size_t>(i)] * p.velocity_mm_per_ms[static_cast<size_t>(i)].squaredNorm();
+  return ke;
+}
+
+StepReport TissueDynamics::step(double max_dt_ms) {
+  TissueParticles& p = tissue_.particles();
+  const std::int64_t n = p.size();
+  StepReport report;
+  const double stable_dt = tissue_.stable_time_step_ms();
+  if (steps_ == 0) first_dt_ms_ = stable_dt;
+  if (!(stable_dt > 1e-4 * first_dt_ms_) || !std::isfinite(stable_dt))
+    throw SolverError(fmt::format("time step collapsed to {:.3g} ms (first step {:.3g} ms) at t = {:.6g} ms", stable_dt,
+                                  first_dt_ms_, time_ms_));
+  const double dt = std::min(stable_dt, max_dt_ms);
+  report.dt_ms = dt;
+
+  // Half kick, constraints, drift.
+  std::vector<Vec3d> constrained_velocity_before(constrained_.size());
+  for (size_t k = 0; k < constrained_.size(); ++k) constrained_velocity_before[k] = p.velocity_mm_per_ms[static_cast<size_t>(constrained_[k])];
+  auto kick = [&](double half_dt, double at_time) {
+    std::vector<Vec3d>& v = p.velocity_mm_per_ms;
+    for (std::int64_t i = 0; i < n; ++i) v[static_cast<size_t>(i)] += half_dt * acceleration_[static_cast<size_t>(i)];
+    apply_constraints(v, at_time);
+  };
+  kick(0.5 * dt, time_ms_ + 0.5 * dt);
+  std::vector<Vec3d> constrained_velocity_half(constrained_.size());
+  for (size_t k = 0; k < constrained_.size(); ++k) constrained_velocity_half[k] = p.velocity_mm_per_ms[static_cast<size_t>(constrained_[k])];
+  std::vector<Vec3d> old_force = p.force_N;
+  std::vector<Vec3d> displacement(static_cast<size_t>(n));
+  parallel_for(n, [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t i = begin; i < end; ++i) {
+      displacement[static_cast<size_t>(i)] = dt * p.velocity_mm_per_ms[static_cast<size_t>(i)];
+      p.position_mm[static_cast<size_t>(i)] += displacement[static_cast<size_t>(i)];
+    }
+  });
+  time_ms_ += dt;
+
+  const ForceReport forces = tissue_.compute_forces(dt);
+  report.bonds_broken_now = forces.bonds_broken_now;
+  report.rate_factor_capped = forces.rate_factor_capped;
+  report.particles_detached_now = forces.particles_detached_now;
+  double model_work = 0, body_work = 0;
+  for (std::int64_t i = 0; i < n; ++i) {
+    const size_t s = static_cast<size_t>(i);
+    if (!p.force_N[s].allFinite()) throw SolverError(fmt::format("non-finite force on particle {} at t = {:.6g} ms", i, time_ms_));
+    model_work += 0.5 * (old_force[s] + p.force_N[s]).dot(displacement[s]);
+    body_work += p.mass_g[s] * body_acceleration_.dot(displacement[s]);
+    acceleration_[s] = p.force_N[s] / p.mass_g[s] + body_acceleration_;
+  }
+  energy_.model_work_mJ += model_work;
+  energy_.body_work_mJ += body_work;
+  kick(0.5 * dt, time_ms_);
+  // Reactions on constrained components: R = m dv/dt - f over the step, working through the displacement.
+  double constraint_work = 0;
+  for (size_t k = 0; k < constrained_.size(); ++k) {
+    const size_t s = static_cast<size_t>(constrained_[k]);
+    for (int axis = 0; axis < 3; ++axis) {
+      if (!(constrained_mask_[s] & (1 << axis))) continue;
+      constraint_work += p.mass_g[s] * (p.velocity_mm_per_ms[s][axis] - constrained_velocity_before[k][axis]) *
+                             constrained_velocity_half[k][axis] -
+                         0.5 * (old_force[s][axis] + p.force_N[s][axis]) * displacement[s][axis];
+    }
+  }
+  energy_.constraint_work_mJ += constraint_work;
+  energy_.kinetic_mJ = kinetic_energy_mJ();
+  if (!std::isfinite(energy_.kinetic_mJ)) throw SolverError(fmt::format("kinetic energy is not finite at t = {:.6g} ms", time_ms_));
+  tissue_.end_of_step();
+  ++steps_;
+  return report;
+}
+
+Eigen::Vector3d TissueDynamics::constraint_internal_force_N(size_t constraint) const {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (std::int32_t i : constraints_.at(constraint).particles) sum += tissue_.particles().force_N[static_cast<size_t>(i)];
+  return sum;
+}
+
+}  // namespace needle

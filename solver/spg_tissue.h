@@ -1,0 +1,97 @@
+#pragma once
+// The SPG tissue: particles with RK shape functions, direct nodal integration, displacement-smoothing
+// stabilization, MAT_018-style plasticity and bond failure. It computes forces from positions; the
+// integrator (explicit_dynamics.h) advances it.
+//
+// Kinematics: F_i = sum_j x_j (x) grad Psi_j(X_i) over the kernel's reference X. Stress: Cauchy,
+// updated from the relative deformation gradient F_n+1 F_n^-1 of the step (tissue_material.h). Force on particle j:
+//   f_j = - sum_i V_i P_i grad Psi_j(X_i) + stabilization,   P = J sigma F^-T (first Piola-Kirchhoff),
+// gathered through the transposed shape functions, so results do not depend on the thread count.
+#include <Eigen/Dense>
+#include <cstdint>
+#include <vector>
+
+#include "mesher/particle_lattice.h"
+#include "solver/bond_network.h"
+#include "solver/rk_shape_functions.h"
+#include "solver/spg_options.h"
+#include "solver/tissue_material.h"
+
+namespace needle {
+
+using Vec3d = Eigen::Vector3d;
+using Mat3d = Eigen::Matrix3d;
+
+// Particle fields, one entry per particle (structure of arrays).
+struct TissueParticles {
+  std::vector<Vec3d> reference_mm;        // kernel reference positions X (reset by kernel re-initialisation)
+  std::vector<Vec3d> initial_mm;          // positions at t = 0 (displacement output)
+  std::vector<Vec3d> position_mm;
+  std::vector<Vec3d> velocity_mm_per_ms;
+  std::vector<Vec3d> force_N;             // internal + stabilization force of the last evaluation
+  std::vector<double> mass_g;
+  std::vector<double> reference_volume_mm3;
+  std::vector<double> spacing_mm;
+  std::vector<double> support_radius_mm;
+  std::vector<std::uint8_t> flags;        // ParticleFlag bits
+  std::vector<Mat3d> deformation_gradient;  // relative to the kernel reference
+  std::vector<Mat3d> stress_MPa;            // Cauchy
+  std::vector<Mat3d> elastic_left_cauchy_green;  // b_e of the material (see tissue_material.h)
+  std::vector<double> plastic_strain;
+  std::vector<double> defect_mm;          // |g_i|, the smoothing defect (zero-energy-mode indicator)
+  std::int64_t size() const { return static_cast<std::int64_t>(position_mm.size()); }
+};
+
+struct ForceReport {
+  std::int64_t bonds_broken_now = 0;
+  std::int64_t rate_factor_capped = 0;  // evaluations where the rate factor hit its cap
+  std::int64_t particles_detached_now = 0;  // crack-face particles whose support collapsed (now free)
+};
+
+class SpgTissue {
+ public:
+  // InputError for a bad material, bad options, or particles that cannot carry shape functions.
+  SpgTissue(const ParticleSet& particles, const TissueMaterial& material, const SpgOptions& options);
+
+  // Forces at the current positions; dt_ms is the increment since the last call (0: first call, no
+  // stress update). Then breaks the bonds that reached the failure criterion and rebuilds their rows.
+  // SolverError on an inverted or non-finite particle.
+  ForceReport compute_forces(double dt_ms);
+
+  // The smallest current spacing over the dilatational wave speed (with stabilization stiffness), x cfl.
+  double stable_time_step_ms() const;
+
+  // Called by the integrator once per step (counts steps for the filter and the kernel update).
+  void end_of_step();
+
+  double stabilization_energy_mJ() const;
+  std::int64_t valid_integration_points() const;
+
+  TissueParticles& particles() { return p_; }
+  const TissueParticles& particles() const { return p_; }
+  const TissueMaterial& material() const { return material_; }
+  const SpgOptions& options() const { return options_; }
+  const RkShapeFunctions& shape_functions() const { return rk_; }
+  const BondNetwork& bonds() const { return bonds_; }
+
+ private:
+  void build_kernel();
+  void update_stable_lengths();
+  void apply_filter();
+  void reinitialize_kernel();
+  std::int64_t break_bonds();
+  Eigen::MatrixX3d reference_matrix() const;
+
+  TissueParticles p_;
+  TissueMaterial material_;
+  SpgOptions options_;
+  RkShapeFunctions rk_;
+  BondNetwork bonds_;
+  std::vector<double> stiffness_;  // kappa_i of the penalty
+  std::vector<double> stable_length_mm_;  // min(spacing, nearest neighbour distance) in the kernel reference
+  std::vector<Vec3d> defect_;      // g_i
+  std::vector<Mat3d> piola_volume_;  // V_i P_i
+  std::int64_t steps_ = 0;
+};
+
+}  // namespace needle

@@ -1,0 +1,138 @@
+#include "solver/tissue_material.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+
+#include "geometry/input_error.h"
+
+namespace needle {
+
+RateLaw rate_law_from_name(const std::string& name) {
+  if (name == "off") return RateLaw::off;
+  if (name == "on" || name == "plausible") return RateLaw::plausible;
+  if (name == "printed") return RateLaw::printed;
+  throw InputError(fmt::format("rate law '{}' is not one of off, on (= plausible), printed", name));
+}
+
+std::string rate_law_name(RateLaw law) {
+  switch (law) {
+    case RateLaw::off: return "off";
+    case RateLaw::plausible: return "plausible";
+    case RateLaw::printed: return "printed";
+  }
+  return "off";
+}
+
+void TissueMaterial::validate() const {
+  auto finite_positive = [](double v) { return std::isfinite(v) && v > 0; };
+  NEEDLE_REQUIRE(finite_positive(E_MPa), fmt::format("tissue E_MPa must be a positive modulus (got {})", E_MPa));
+  NEEDLE_REQUIRE(std::isfinite(nu) && nu > -1.0 && nu < 0.5,
+                 fmt::format("tissue nu must lie in (-1, 0.5) (got {}); 0.5 would be incompressible", nu));
+  NEEDLE_REQUIRE(finite_positive(density_g_per_cm3), fmt::format("tissue density_g_per_cm3 must be positive (got {})", density_g_per_cm3));
+  NEEDLE_REQUIRE(finite_positive(k_MPa), fmt::format("tissue k_MPa must be positive (got {})", k_MPa));
+  NEEDLE_REQUIRE(std::isfinite(n) && n > 1.0 && n < 20.0,
+                 fmt::format("tissue hardening exponent n must lie in (1, 20) (got {}); eps_yp = (E/k)^(1/(n-1))", n));
+  NEEDLE_REQUIRE(finite_positive(rate_C_per_ms), fmt::format("rate law C_per_ms must be positive (got {})", rate_C_per_ms));
+  NEEDLE_REQUIRE(finite_positive(rate_p), fmt::format("rate law p must be positive (got {})", rate_p));
+  NEEDLE_REQUIRE(std::isfinite(max_rate_factor) && max_rate_factor >= 1.0,
+                 fmt::format("max_rate_factor must be >= 1 (got {})", max_rate_factor));
+  const double eps_yp = yield_strain();
+  NEEDLE_REQUIRE(std::isfinite(eps_yp) && eps_yp < 100.0,
+                 fmt::format("E = {} MPa with k = {} MPa, n = {} gives a yield strain {:.3g}: the card never yields", E_MPa, k_MPa, n, eps_yp));
+}
+
+double TissueMaterial::yield_strain() const { return std::pow(E_MPa / k_MPa, 1.0 / (n - 1.0)); }
+
+double TissueMaterial::rate_factor(double strain_rate_per_ms, bool* capped) const {
+  if (capped) *capped = false;
+  if (rate_law == RateLaw::off || !(strain_rate_per_ms > 0)) return 1.0;
+  const double exponent = rate_law == RateLaw::printed ? 1.0 / rate_p : rate_p;
+  const double log_term = exponent * std::log(strain_rate_per_ms / rate_C_per_ms);
+  const double log_cap = std::log(max_rate_factor - 1.0 > 0 ? max_rate_factor - 1.0 : 1e-300);
+  if (log_term >= log_cap) {
+    if (capped) *capped = true;
+    return max_rate_factor;
+  }
+  return 1.0 + std::exp(log_term);
+}
+
+double TissueMaterial::yield_stress_MPa(double plastic_strain, double factor) const {
+  return factor * k_MPa * std::pow(yield_strain() + plastic_strain, n);
+}
+
+double TissueMaterial::hardening_slope_MPa(double plastic_strain, double factor) const {
+  return factor * k_MPa * n * std::pow(yield_strain() + plastic_strain, n - 1.0);
+}
+
+StressUpdate update_stress(const TissueMaterial& m, const MaterialPoint& state, const Eigen::Matrix3d& f, double dt_ms) {
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  // Elastic trial: b_e = f b_e f^T, principal log strains.
+  const Eigen::Matrix3d b_trial = f * state.elastic_left_cauchy_green * f.transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  eig.computeDirect(b_trial);
+  const Eigen::Vector3d lambda_sq = eig.eigenvalues().cwiseMax(1e-300);
+  Eigen::Vector3d h = 0.5 * lambda_sq.array().log().matrix();
+
+  // Effective strain rate of the increment, from the deviatoric log strain of f f^T.
+  double rate = 0.0;
+  if (dt_ms > 0) {
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> inc;
+    inc.computeDirect(f * f.transpose(), Eigen::EigenvaluesOnly);
+    Eigen::Vector3d d = 0.5 * inc.eigenvalues().cwiseMax(1e-300).array().log().matrix();
+    d.array() -= d.mean();
+    rate = std::sqrt(2.0 / 3.0 * d.squaredNorm()) / dt_ms;
+  }
+  bool capped = false;
+  const double factor = m.rate_factor(rate, &capped);
+
+  const double mu = m.shear_modulus_MPa(), lambda = m.lame_lambda_MPa();
+  const double volumetric = h.sum();
+  const Eigen::Vector3d h_dev = h.array() - volumetric / 3.0;
+  Eigen::Vector3d s = 2 * mu * h_dev;  // principal deviatoric Cauchy stress
+  const double q_trial = std::sqrt(1.5 * s.squaredNorm());
+  double eps_p = state.plastic_strain;
+  if (q_trial > m.yield_stress_MPa(eps_p, factor)) {
+    // Radial return: q_trial - 3 mu dg = sigma_y(eps_p + dg); Newton with bisection bounds.
+    double lo = 0.0, hi = q_trial / (3 * mu), dg = 0.0;
+    for (int it = 0; it < 60; ++it) {
+      const double residual = q_trial - 3 * mu * dg - m.yield_stress_MPa(eps_p + dg, factor);
+      if (residual > 0) lo = dg; else hi = dg;
+      if (std::abs(residual) < 1e-12 * q_trial) break;
+      double next = dg + residual / (3 * mu + m.hardening_slope_MPa(eps_p + dg, factor));
+      if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+      dg = next;
+    }
+    const Eigen::Vector3d flow = 1.5 * s / q_trial;  // unit plastic flow direction (deviatoric)
+    h -= dg * flow;
+    s *= 1.0 - 3 * mu * dg / q_trial;
+    eps_p += dg;
+  }
+  const Eigen::Matrix3d& V = eig.eigenvectors();
+  const Eigen::Vector3d sigma_principal = s.array() + (lambda + 2.0 * mu / 3.0) * volumetric;
+  StressUpdate out;
+  out.state.elastic_left_cauchy_green = V * (2.0 * h).array().exp().matrix().asDiagonal() * V.transpose();
+  out.state.plastic_strain = eps_p;
+  out.cauchy_stress_MPa = V * sigma_principal.asDiagonal() * V.transpose();
+  out.rate_factor_capped = capped;
+  (void)I;
+  return out;
+}
+
+double uniaxial_true_stress_MPa(const TissueMaterial& m, double true_strain, double strain_rate_per_ms) {
+  const double factor = m.rate_factor(strain_rate_per_ms);
+  const double eps = std::abs(true_strain);
+  const double elastic = m.E_MPa * eps;
+  if (elastic <= m.yield_stress_MPa(0.0, factor)) return true_strain < 0 ? -elastic : elastic;
+  // Plastic: find eps_p in [0, eps] with  E (eps - eps_p) = sigma_y(eps_p); the left side falls and the
+  // right side rises with eps_p, so the root is unique.
+  double lo = 0.0, hi = eps;
+  for (int it = 0; it < 200; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    if (m.E_MPa * (eps - mid) > m.yield_stress_MPa(mid, factor)) lo = mid; else hi = mid;
+  }
+  const double stress = m.yield_stress_MPa(0.5 * (lo + hi), factor);
+  return true_strain < 0 ? -stress : stress;
+}
+
+}  // namespace needle

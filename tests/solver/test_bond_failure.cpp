@@ -1,0 +1,96 @@
+// Bond failure: a notched bar pulled apart separates through the notch when the bonds' mean plastic
+// strain passes the threshold; broken bonds are counted, every particle and its mass survive.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <numeric>
+
+#include "solver/explicit_dynamics.h"
+#include "tests/solver/solver_fixtures.h"
+
+using namespace needle;
+
+namespace {
+
+// Union-find over the intact bonds.
+std::vector<int> components(const SpgTissue& tissue) {
+  std::vector<int> parent(static_cast<size_t>(tissue.particles().size()));
+  std::iota(parent.begin(), parent.end(), 0);
+  std::function<int(int)> find = [&](int i) { return parent[static_cast<size_t>(i)] == i ? i : parent[static_cast<size_t>(i)] = find(parent[static_cast<size_t>(i)]); };
+  for (const Bond& b : tissue.bonds().bonds)
+    if (!b.broken) parent[static_cast<size_t>(find(b.i))] = find(b.j);
+  std::vector<int> root(parent.size());
+  for (size_t i = 0; i < parent.size(); ++i) root[i] = find(static_cast<int>(i));
+  return root;
+}
+
+}  // namespace
+
+TEST_CASE("A notched bar pulled apart separates at the bond-failure strain", "[solver][failure]") {
+  // 12 x 3 x 2 mm bar, a notch of one particle plane removed over the lower half at x = 6.
+  ParticleSet full = needle_test::free_box({0, -1.5, 0}, {12, 1.5, 2}, 0.5);
+  std::vector<Eigen::Index> keep;
+  for (Eigen::Index i = 0; i < full.x_mm.rows(); ++i)
+    if (!(std::abs(full.x_mm(i, 0) - 6.0) < 1e-9 && full.x_mm(i, 1) < 0.1)) keep.push_back(i);
+  ParticleSet set = full;
+  set.x_mm = full.x_mm(keep, Eigen::all);
+  set.volume_mm3 = full.volume_mm3(keep);
+  set.spacing_mm = full.spacing_mm(keep);
+  set.flags = full.flags(keep);
+
+  TissueMaterial m;
+  m.E_MPa = 0.1;  // yields at strain 0.49
+  m.rate_law = RateLaw::off;
+  SpgOptions options;
+  options.bond_failure.plastic_strain = 0.1;
+  SpgTissue tissue(set, m, options);
+  TissueParticles& p = tissue.particles();
+  const double total_mass = std::accumulate(p.mass_g.begin(), p.mass_g.end(), 0.0);
+  std::vector<std::int32_t> left, right;
+  for (std::int64_t i = 0; i < p.size(); ++i) {
+    if (p.reference_mm[static_cast<size_t>(i)].x() < 1e-9) left.push_back(static_cast<std::int32_t>(i));
+    if (p.reference_mm[static_cast<size_t>(i)].x() > 12 - 1e-9) right.push_back(static_cast<std::int32_t>(i));
+  }
+  const double speed = 0.5;  // mm/ms each grip
+  for (std::int64_t i = 0; i < p.size(); ++i)
+    p.velocity_mm_per_ms[static_cast<size_t>(i)].x() = speed * (p.reference_mm[static_cast<size_t>(i)].x() - 6.0) / 6.0;
+  TissueDynamics dynamics(tissue, {{left, 0, [=](double) { return -speed; }, {}}, {right, 0, [=](double) { return speed; }, {}}});
+  double first_break_max_bond_strain = -1;
+  bool separated = false;
+  while (dynamics.time_ms() < 30.0 && !separated) {
+    // The largest mean plastic strain over intact bonds before the step: the first break must come
+    // when it reaches the threshold, not before.
+    double max_bond_strain = 0;
+    for (const Bond& b : tissue.bonds().bonds)
+      if (!b.broken) max_bond_strain = std::max(max_bond_strain, 0.5 * (p.plastic_strain[static_cast<size_t>(b.i)] + p.plastic_strain[static_cast<size_t>(b.j)]));
+    const StepReport step = dynamics.step();
+    if (step.bonds_broken_now > 0 && first_break_max_bond_strain < 0) first_break_max_bond_strain = max_bond_strain;
+    if (tissue.bonds().broken_count > 0 && dynamics.steps() % 20 == 0) {
+      const std::vector<int> root = components(tissue);
+      separated = root[static_cast<size_t>(left.front())] != root[static_cast<size_t>(right.front())];
+    }
+  }
+  REQUIRE(separated);
+  INFO("broken bonds " << tissue.bonds().broken_count << ", first break after the bond strain reached " << first_break_max_bond_strain);
+  CHECK(first_break_max_bond_strain > 0.8 * options.bond_failure.plastic_strain);
+  CHECK(first_break_max_bond_strain <= 1.2 * options.bond_failure.plastic_strain);
+  // Every broken bond met the criterion (plastic strain only grows).
+  std::int64_t broken = 0;
+  for (const Bond& b : tissue.bonds().bonds) {
+    if (!b.broken) continue;
+    ++broken;
+    CHECK(0.5 * (p.plastic_strain[static_cast<size_t>(b.i)] + p.plastic_strain[static_cast<size_t>(b.j)]) > options.bond_failure.plastic_strain);
+  }
+  CHECK(broken == tissue.bonds().broken_count);
+  // The crack runs through the notch plane: every broken bond straddles or touches x = 6 +- 1 mm.
+  for (const Bond& b : tissue.bonds().bonds)
+    if (b.broken) CHECK(std::abs(0.5 * (p.reference_mm[static_cast<size_t>(b.i)].x() + p.reference_mm[static_cast<size_t>(b.j)].x()) - 6.0) < 1.5);
+  // Mass: all particles are still there, the two pieces together weigh what the bar did.
+  const std::vector<int> root = components(tissue);
+  double left_mass = 0, right_mass = 0;
+  for (std::int64_t i = 0; i < p.size(); ++i)
+    (root[static_cast<size_t>(i)] == root[static_cast<size_t>(left.front())] ? left_mass : right_mass) += p.mass_g[static_cast<size_t>(i)];
+  CHECK(left_mass + right_mass == Approx(total_mass).epsilon(1e-14));
+  CHECK(left_mass > 0.3 * total_mass);
+  CHECK(right_mass > 0.3 * total_mass);
+  for (const auto& x : p.position_mm) CHECK(x.allFinite());
+}

@@ -1,0 +1,126 @@
+// RK shape functions: partition of unity and linear reproduction (values and gradients) at the
+// particles and between them, on regular and jittered sets; gradients against finite differences;
+// rows rebuilt without cut entries keep both properties.
+#include <catch2/catch.hpp>
+#include <random>
+
+#include "solver/rk_shape_functions.h"
+#include "tests/solver/solver_fixtures.h"
+
+using namespace needle;
+
+namespace {
+
+struct Worst {
+  double unity = 0, linear = 0, gradient_unity = 0, gradient_linear = 0;
+};
+
+Worst check_rows(const RkShapeFunctions& rk, const Eigen::MatrixX3d& points, const Eigen::MatrixX3d& centres) {
+  Worst w;
+  for (std::int64_t i = 0; i < rk.rows(); ++i) {
+    REQUIRE(rk.valid[static_cast<size_t>(i)]);
+    double sum = 0;
+    Eigen::Vector3d x = Eigen::Vector3d::Zero(), g = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d G = Eigen::Matrix3d::Zero();
+    for (std::int64_t e = rk.offset[static_cast<size_t>(i)]; e < rk.offset[static_cast<size_t>(i + 1)]; ++e) {
+      const Eigen::Vector3d X = centres.row(rk.centre[static_cast<size_t>(e)]).transpose();
+      const Eigen::Vector3d grad(rk.grad[static_cast<size_t>(e)][0], rk.grad[static_cast<size_t>(e)][1], rk.grad[static_cast<size_t>(e)][2]);
+      sum += rk.psi[static_cast<size_t>(e)];
+      x += rk.psi[static_cast<size_t>(e)] * X;
+      g += grad;
+      G += X * grad.transpose();
+    }
+    w.unity = std::max(w.unity, std::abs(sum - 1));
+    w.linear = std::max(w.linear, (x - points.row(i).transpose()).norm());
+    w.gradient_unity = std::max(w.gradient_unity, g.norm());
+    w.gradient_linear = std::max(w.gradient_linear, (G - Eigen::Matrix3d::Identity()).norm());
+  }
+  return w;
+}
+
+Eigen::VectorXd radii(const ParticleSet& set, double dilation) { return dilation * set.spacing_mm; }
+
+}  // namespace
+
+TEST_CASE("RK shape functions reproduce constants and linear fields at the particles", "[solver][rk]") {
+  for (double jitter : {0.0, 0.3}) {
+    const ParticleSet set = needle_test::jittered(needle_test::free_box({0, 0, 0}, {4, 3, 2}, 0.5), jitter);
+    const RkShapeFunctions rk = build_rk_shape_functions(set.x_mm, radii(set, 1.8));
+    const Worst w = check_rows(rk, set.x_mm, set.x_mm);
+    INFO("jitter " << jitter);
+    CHECK(w.unity < 1e-12);
+    CHECK(w.linear < 1e-12);
+    CHECK(w.gradient_unity < 1e-11);   // 1/mm, h = 0.5 mm
+    CHECK(w.gradient_linear < 1e-12);
+    // The transpose lists every entry exactly once.
+    CHECK(rk.column_entry.size() == rk.centre.size());
+  }
+}
+
+TEST_CASE("RK shape functions reproduce linear fields between particles", "[solver][rk]") {
+  const ParticleSet set = needle_test::jittered(needle_test::free_box({0, 0, 0}, {4, 3, 2}, 0.5), 0.3);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  Eigen::MatrixX3d points(300, 3);
+  for (int i = 0; i < 300; ++i) points.row(i) << 4 * u(rng), 3 * u(rng), 2 * u(rng);
+  const RkShapeFunctions rk = evaluate_rk_shape_functions(points, set.x_mm, radii(set, 1.8));
+  const Worst w = check_rows(rk, points, set.x_mm);
+  CHECK(w.unity < 1e-12);
+  CHECK(w.linear < 1e-12);
+  CHECK(w.gradient_unity < 1e-11);
+  CHECK(w.gradient_linear < 1e-12);
+}
+
+TEST_CASE("RK gradients are the derivatives of the shape functions", "[solver][rk]") {
+  const ParticleSet set = needle_test::jittered(needle_test::free_box({0, 0, 0}, {3, 3, 3}, 0.5), 0.25);
+  const Eigen::VectorXd r = radii(set, 1.8);
+  const Eigen::RowVector3d x0(1.37, 1.61, 1.23);
+  Eigen::MatrixX3d point(1, 3);
+  point.row(0) = x0;
+  const RkShapeFunctions at = evaluate_rk_shape_functions(point, set.x_mm, r);
+  const double step = 1e-6;
+  double worst = 0, scale = 0;
+  for (int k = 0; k < 3; ++k) {
+    Eigen::MatrixX3d plus = point, minus = point;
+    plus(0, k) += step;
+    minus(0, k) -= step;
+    const RkShapeFunctions p = evaluate_rk_shape_functions(plus, set.x_mm, r);
+    const RkShapeFunctions m = evaluate_rk_shape_functions(minus, set.x_mm, r);
+    REQUIRE(p.centre == at.centre);
+    REQUIRE(m.centre == at.centre);
+    for (size_t e = 0; e < at.centre.size(); ++e) {
+      const double fd = (p.psi[e] - m.psi[e]) / (2 * step);
+      worst = std::max(worst, std::abs(fd - at.grad[e][static_cast<size_t>(k)]));
+      scale = std::max(scale, std::abs(at.grad[e][static_cast<size_t>(k)]));
+    }
+  }
+  CHECK(scale > 0.1);
+  CHECK(worst < 1e-6 * scale);
+}
+
+TEST_CASE("Rows rebuilt without cut entries keep reproduction; too few entries invalidate a row", "[solver][rk]") {
+  const ParticleSet set = needle_test::free_box({0, 0, 0}, {3, 3, 3}, 0.5);
+  const Eigen::VectorXd r = radii(set, 1.8);
+  RkShapeFunctions rk = build_rk_shape_functions(set.x_mm, r);
+  const std::int64_t row = 100;
+  const std::int64_t begin = rk.offset[row], end = rk.offset[row + 1];
+  for (std::int64_t e = begin; e < end; e += 3)
+    if (rk.centre[static_cast<size_t>(e)] != row) rk.cut[static_cast<size_t>(e)] = 1;
+  rebuild_rk_rows(rk, {row}, set.x_mm, set.x_mm, r);
+  REQUIRE(rk.valid[row]);
+  double sum = 0;
+  Eigen::Vector3d x = Eigen::Vector3d::Zero();
+  for (std::int64_t e = begin; e < end; ++e) {
+    if (rk.cut[static_cast<size_t>(e)]) CHECK(rk.psi[static_cast<size_t>(e)] == 0.0);
+    sum += rk.psi[static_cast<size_t>(e)];
+    x += rk.psi[static_cast<size_t>(e)] * set.x_mm.row(rk.centre[static_cast<size_t>(e)]).transpose();
+  }
+  CHECK(std::abs(sum - 1) < 1e-12);
+  CHECK((x - set.x_mm.row(row).transpose()).norm() < 1e-12);
+  // Cut all but self and two neighbours: 3 centres cannot carry a linear basis.
+  int kept = 0;
+  for (std::int64_t e = begin; e < end; ++e)
+    if (rk.centre[static_cast<size_t>(e)] != row && kept++ >= 2) rk.cut[static_cast<size_t>(e)] = 1;
+  rebuild_rk_rows(rk, {row}, set.x_mm, set.x_mm, r);
+  CHECK_FALSE(rk.valid[row]);
+}

@@ -1,0 +1,109 @@
+// The tissue card: parameter checks, the safe rate law, objectivity of the stress update, and the
+// particle specimen's uniaxial curve against the closed-form MAT_018 curve (computed independently by
+// bisection on the scalar law).
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "geometry/input_error.h"
+#include "solver/spg_tissue.h"
+#include "solver/uniaxial_test.h"
+#include "tests/solver/solver_fixtures.h"
+
+using namespace needle;
+
+TEST_CASE("Bad tissue cards and kernel parameters are refused with the field named", "[solver][material]") {
+  auto refused = [](TissueMaterial m) { CHECK_THROWS_AS(m.validate(), InputError); };
+  TissueMaterial m;
+  m.E_MPa = -1;
+  refused(m);
+  m = {}, m.nu = 0.5, refused(m);
+  m = {}, m.nu = 0.7, refused(m);
+  m = {}, m.n = 1.0, refused(m);
+  m = {}, m.density_g_per_cm3 = 0, refused(m);
+  m = {}, m.k_MPa = std::nan(""), refused(m);
+  m = {}, m.rate_C_per_ms = -0.1, refused(m);
+  CHECK_THROWS_WITH(([] { TissueMaterial bad; bad.E_MPa = -1; bad.validate(); })(), Catch::Contains("E_MPa"));
+  SpgOptions o;
+  o.dilation = 0.9;
+  CHECK_THROWS_WITH(o.validate(), Catch::Contains("dilation"));
+  o = {};
+  o.cfl = 0;
+  CHECK_THROWS_AS(o.validate(), InputError);
+  ParticleSet set = needle_test::free_box({0, 0, 0}, {2, 2, 2}, 0.5);
+  set.spacing_mm.setZero();
+  CHECK_THROWS_WITH(SpgTissue(set, TissueMaterial{}, SpgOptions{}), Catch::Contains("spacing"));
+  CHECK_THROWS_AS(rate_law_from_name("sometimes"), InputError);
+}
+
+TEST_CASE("The rate factor follows Cowper-Symonds and never overflows", "[solver][material]") {
+  TissueMaterial m;
+  m.rate_law = RateLaw::plausible;
+  CHECK(m.rate_factor(10.0) == Approx(1 + std::pow(100.0, 0.1)).epsilon(1e-12));  // 1e4 /s: 2.585
+  CHECK(m.rate_factor(0.0) == 1.0);
+  m.rate_law = RateLaw::printed;
+  bool capped = false;
+  const double printed = m.rate_factor(10.0, &capped);  // 1 + 100^10 = 1e20 uncapped
+  CHECK(capped);
+  CHECK(printed == m.max_rate_factor);
+  CHECK(m.rate_factor(0.01, &capped) == Approx(1 + 1e-10).epsilon(1e-14));
+  CHECK_FALSE(capped);
+  CHECK(std::isfinite(m.rate_factor(1e300)));
+  m.rate_law = RateLaw::off;
+  CHECK(m.rate_factor(1e3) == 1.0);
+}
+
+TEST_CASE("The stress update is objective: a rigid rotation rotates the stress", "[solver][material]") {
+  TissueMaterial m;
+  m.E_MPa = 0.1;  // yields early, so plastic strain and elastic strain both present
+  m.rate_law = RateLaw::off;
+  Eigen::Matrix3d F;
+  F << 2.4, 0.2, 0.0, 0.1, 0.7, 0.05, 0.0, -0.1, 0.65;
+  const StressUpdate loaded = update_stress(m, MaterialPoint{}, F, 1.0);
+  REQUIRE(loaded.state.plastic_strain > 0);
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  const StressUpdate rotated = update_stress(m, loaded.state, R, 1.0);
+  CHECK((rotated.cauchy_stress_MPa - R * loaded.cauchy_stress_MPa * R.transpose()).norm() < 1e-12 * loaded.cauchy_stress_MPa.norm());
+  CHECK(rotated.state.plastic_strain == Approx(loaded.state.plastic_strain).epsilon(1e-14));
+}
+
+TEST_CASE("Uniaxial tension of a particle specimen follows the closed-form MAT_018 curve to strain 1.5", "[solver][material][uniaxial]") {
+  struct Card {
+    double E, k, n, nu;
+  };
+  // The paper's card with its default E (elastic over the range), a card that yields early, another law.
+  for (const Card card : {Card{0.665, 0.35, 2.75, 0.45}, Card{0.1, 0.35, 2.75, 0.45}, Card{0.2, 0.5, 2.0, 0.3}}) {
+    TissueMaterial m;
+    m.E_MPa = card.E, m.k_MPa = card.k, m.n = card.n, m.nu = card.nu;
+    m.rate_law = RateLaw::off;
+    const UniaxialCurve curve = run_uniaxial_test(m, UniaxialTestOptions{});
+    INFO("card E " << card.E << " k " << card.k << " n " << card.n << ": max error " << curve.max_relative_error());
+    REQUIRE(curve.true_strain.back() == Approx(1.5).epsilon(1e-3));
+    CHECK(curve.max_relative_error() < 0.03);
+    // The closed form here is the scalar law; check it is really the MAT_018 curve at the end point.
+    const double eps = curve.true_strain.back(), sigma = curve.closed_form_stress_MPa.back();
+    const double eps_p = eps - sigma / m.E_MPa;
+    CHECK(sigma == Approx(eps_p > 1e-9 ? m.k_MPa * std::pow(m.yield_strain() + eps_p, m.n) : m.E_MPa * eps).epsilon(1e-9));
+    CHECK(curve.max_energy_error < 0.01);
+    double worst_lateral = 0;
+    for (double s : curve.lateral_stress_MPa) worst_lateral = std::max(worst_lateral, std::abs(s));
+    CHECK(worst_lateral < 0.01 * std::abs(sigma));  // the servo keeps the state uniaxial
+  }
+}
+
+TEST_CASE("The rate law stiffens the specimen by the Cowper-Symonds factor at the imposed rate", "[solver][material][uniaxial]") {
+  TissueMaterial m;
+  m.E_MPa = 0.1;  // yields at strain 0.49 (0.95 with the rate factor), plastic beyond
+  UniaxialTestOptions options;
+  m.rate_law = RateLaw::off;
+  const UniaxialCurve slow = run_uniaxial_test(m, options);
+  m.rate_law = RateLaw::plausible;
+  const UniaxialCurve fast = run_uniaxial_test(m, options);
+  const double factor = m.rate_factor(options.strain_rate_per_ms);  // 1 + (0.05 / 0.1)^0.1 = 1.933
+  CHECK(fast.max_relative_error() < 0.03);
+  // At the end both are plastic: the flow stress at the specimen's own plastic strain is factor x static.
+  REQUIRE(fast.plastic_strain.back() > 0.02);
+  const double static_flow = m.k_MPa * std::pow(m.yield_strain() + fast.plastic_strain.back(), m.n);
+  INFO("measured factor " << fast.true_stress_MPa.back() / static_flow << ", expected " << factor);
+  CHECK(fast.true_stress_MPa.back() / static_flow == Approx(factor).epsilon(0.03));
+  CHECK(fast.true_stress_MPa.back() > 1.05 * slow.true_stress_MPa.back());
+}
