@@ -38,6 +38,9 @@ TissueDynamics::TissueDynamics(SpgTissue& tissue, std::vector<VelocityConstraint
     for (std::int32_t i : c.particles) constrained_mask_[static_cast<size_t>(i)] |= static_cast<std::uint8_t>(1 << c.axis);
   for (std::int64_t i = 0; i < p.size(); ++i)
     if (constrained_mask_[static_cast<size_t>(i)]) constrained_.push_back(static_cast<std::int32_t>(i));
+  constrained_velocity_before_.resize(constrained_.size());
+  constrained_velocity_half_.resize(constrained_.size());
+  displacement_.resize(static_cast<size_t>(p.size()));
   tissue_.compute_forces(0.0);
   acceleration_.resize(static_cast<size_t>(p.size()));
   for (std::int64_t i = 0; i < p.size(); ++i)
@@ -81,7 +84,8 @@ StepReport TissueDynamics::step(double max_dt_ms) {
   report.dt_ms = dt;
 
   // Half kick, constraints, drift.
-  std::vector<Vec3d> constrained_velocity_before(constrained_.size());
+  std::vector<Vec3d>& constrained_velocity_before = constrained_velocity_before_;
+  std::vector<Vec3d>& constrained_velocity_half = constrained_velocity_half_;
   for (size_t k = 0; k < constrained_.size(); ++k) constrained_velocity_before[k] = p.velocity_mm_per_ms[static_cast<size_t>(constrained_[k])];
   auto kick = [&](double half_dt, double at_time) {
     std::vector<Vec3d>& v = p.velocity_mm_per_ms;
@@ -89,10 +93,10 @@ StepReport TissueDynamics::step(double max_dt_ms) {
     apply_constraints(v, at_time);
   };
   kick(0.5 * dt, time_ms_ + 0.5 * dt);
-  std::vector<Vec3d> constrained_velocity_half(constrained_.size());
   for (size_t k = 0; k < constrained_.size(); ++k) constrained_velocity_half[k] = p.velocity_mm_per_ms[static_cast<size_t>(constrained_[k])];
-  std::vector<Vec3d> old_force = p.force_N;
-  std::vector<Vec3d> displacement(static_cast<size_t>(n));
+  std::vector<Vec3d>& old_force = old_force_;
+  std::vector<Vec3d>& displacement = displacement_;
+  old_force = p.force_N;
   parallel_for(n, [&](std::int64_t begin, std::int64_t end) {
     for (std::int64_t i = begin; i < end; ++i) {
       displacement[static_cast<size_t>(i)] = dt * p.velocity_mm_per_ms[static_cast<size_t>(i)];

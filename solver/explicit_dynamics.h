@@ -68,6 +68,8 @@ class TissueDynamics {
   std::vector<Vec3d> acceleration_;
   std::vector<std::int32_t> constrained_;      // particles with a constrained component
   std::vector<std::uint8_t> constrained_mask_;  // per particle: bit k = component k constrained
+  // Step scratch, kept to avoid allocating per step.
+  std::vector<Vec3d> old_force_, displacement_, constrained_velocity_before_, constrained_velocity_half_;
 };
 
 }  // namespace needle

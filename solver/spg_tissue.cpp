@@ -30,6 +30,13 @@ Mat3d gather_gradient(const RkShapeFunctions& rk, std::int64_t i, const std::vec
   return F;
 }
 
+// Smallest principal stretch of F (the square root of the smallest eigenvalue of F^T F).
+double smallest_stretch(const Mat3d& F) {
+  Eigen::SelfAdjointEigenSolver<Mat3d> eig;
+  eig.computeDirect(F.transpose() * F, Eigen::EigenvaluesOnly);
+  return std::sqrt(std::max(eig.eigenvalues()[0], 0.0));
+}
+
 }  // namespace
 
 SpgTissue::SpgTissue(const ParticleSet& set, const TissueMaterial& material, const SpgOptions& options)
@@ -65,6 +72,8 @@ SpgTissue::SpgTissue(const ParticleSet& set, const TissueMaterial& material, con
   p_.defect_mm.assign(static_cast<size_t>(n), 0.0);
   defect_.assign(static_cast<size_t>(n), Vec3d::Zero());
   piola_volume_.assign(static_cast<size_t>(n), Mat3d::Zero());
+  min_stretch_.assign(static_cast<size_t>(n), 1.0);
+  point_status_.assign(static_cast<size_t>(n), 0);
   stiffness_.resize(static_cast<size_t>(n));
   for (std::int64_t i = 0; i < n; ++i) {
     const double h = p_.spacing_mm[static_cast<size_t>(i)];
@@ -78,14 +87,14 @@ SpgTissue::SpgTissue(const ParticleSet& set, const TissueMaterial& material, con
                                          "at dilation {}: use a larger dilation or a thicker particle set", n - valid, n, options_.dilation));
 }
 
-Eigen::MatrixX3d SpgTissue::reference_matrix() const {
-  Eigen::MatrixX3d X(p_.size(), 3);
-  for (std::int64_t i = 0; i < p_.size(); ++i) X.row(i) = p_.reference_mm[static_cast<size_t>(i)].transpose();
-  return X;
+void SpgTissue::refresh_reference_matrix() {
+  reference_.resize(p_.size(), 3);
+  for (std::int64_t i = 0; i < p_.size(); ++i) reference_.row(i) = p_.reference_mm[static_cast<size_t>(i)].transpose();
 }
 
 void SpgTissue::build_kernel() {
-  const Eigen::MatrixX3d X = reference_matrix();
+  refresh_reference_matrix();
+  const Eigen::MatrixX3d& X = reference_;
   const Eigen::Map<const Eigen::VectorXd> radius(p_.support_radius_mm.data(), p_.size());
   rk_ = build_rk_shape_functions(X, radius);
   bonds_ = build_bond_network(rk_);
@@ -112,9 +121,9 @@ std::int64_t SpgTissue::valid_integration_points() const {
 ForceReport SpgTissue::compute_forces(double dt_ms) {
   ForceReport report;
   const std::int64_t n = p_.size();
-  std::vector<std::uint8_t> capped(static_cast<size_t>(n), 0);
-  std::vector<std::uint8_t> failed(static_cast<size_t>(n), 0);
-  std::vector<std::uint8_t> detached(static_cast<size_t>(n), 0);
+  enum : std::uint8_t { kCapped = 1, kFailed = 2, kDetached = 4 };
+  std::vector<std::uint8_t>& status = point_status_;
+  std::fill(status.begin(), status.end(), std::uint8_t{0});
   // 1. Deformation gradient, stress update, V P and the smoothing defect at every integration point.
   parallel_for(n, [&](std::int64_t begin, std::int64_t end) {
     for (std::int64_t i = begin; i < end; ++i) {
@@ -136,10 +145,10 @@ ForceReport SpgTissue::compute_forces(double dt_ms) {
         bool on_crack = false;
         for (std::int64_t e = rk_.offset[s]; e < rk_.offset[s + 1] && !on_crack; ++e) on_crack = rk_.cut[static_cast<size_t>(e)];
         if (!on_crack) {
-          failed[s] = 1;
+          status[s] = kFailed;
           continue;
         }
-        detached[s] = 1;
+        status[s] = kDetached;
         piola_volume_[s].setZero();
         p_.stress_MPa[s].setZero();
         p_.elastic_left_cauchy_green[s].setIdentity();
@@ -151,20 +160,21 @@ ForceReport SpgTissue::compute_forces(double dt_ms) {
         p_.stress_MPa[s] = u.cauchy_stress_MPa;
         p_.elastic_left_cauchy_green[s] = u.state.elastic_left_cauchy_green;
         p_.plastic_strain[s] = u.state.plastic_strain;
-        capped[s] = u.rate_factor_capped;
+        if (u.rate_factor_capped) status[s] = kCapped;
       }
       p_.deformation_gradient[s] = F;
+      min_stretch_[s] = smallest_stretch(F);
       piola_volume_[s] = p_.reference_volume_mm3[s] * J * p_.stress_MPa[s] * F.inverse().transpose();
     }
   });
   for (std::int64_t i = 0; i < n; ++i)
-    if (failed[static_cast<size_t>(i)])
+    if (status[static_cast<size_t>(i)] & kFailed)
       throw SolverError(fmt::format("particle {} inverted or blew up (det F <= {} or not finite) near x = ({:.3f}, {:.3f}, {:.3f}) mm",
                                     i, kMinJacobian, p_.position_mm[static_cast<size_t>(i)].x(),
                                     p_.position_mm[static_cast<size_t>(i)].y(), p_.position_mm[static_cast<size_t>(i)].z()));
-  report.rate_factor_capped = std::count(capped.begin(), capped.end(), std::uint8_t{1});
+  report.rate_factor_capped = std::count(status.begin(), status.end(), std::uint8_t{kCapped});
   for (std::int64_t i = 0; i < n; ++i)
-    if (detached[static_cast<size_t>(i)]) {
+    if (status[static_cast<size_t>(i)] & kDetached) {
       const size_t s = static_cast<size_t>(i);
       rk_.valid[s] = 0;
       for (std::int64_t e = rk_.offset[s]; e < rk_.offset[s + 1]; ++e) {
@@ -224,14 +234,18 @@ std::int64_t SpgTissue::break_bonds() {
   if (rows.empty()) return 0;
   std::sort(rows.begin(), rows.end());
   rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
-  const Eigen::MatrixX3d X = reference_matrix();
   const Eigen::Map<const Eigen::VectorXd> radius(p_.support_radius_mm.data(), p_.size());
-  rebuild_rk_rows(rk_, rows, X, X, radius);
+  rebuild_rk_rows(rk_, rows, reference_, reference_, radius);
   // The next stress increment must see only motion, not the change of shape functions: restart F there.
   for (std::int64_t i : rows) {
     const size_t s = static_cast<size_t>(i);
-    if (rk_.valid[s]) p_.deformation_gradient[s] = gather_gradient(rk_, i, p_.position_mm);
-    else p_.stress_MPa[s].setZero(), p_.elastic_left_cauchy_green[s].setIdentity();
+    if (rk_.valid[s]) {
+      p_.deformation_gradient[s] = gather_gradient(rk_, i, p_.position_mm);
+      min_stretch_[s] = smallest_stretch(p_.deformation_gradient[s]);
+    } else {
+      p_.stress_MPa[s].setZero();
+      p_.elastic_left_cauchy_green[s].setIdentity();
+    }
   }
   const std::int64_t count = static_cast<std::int64_t>(std::count(breaking.begin(), breaking.end(), std::uint8_t{1}));
   bonds_.broken_count += count;
@@ -241,20 +255,12 @@ std::int64_t SpgTissue::break_bonds() {
 double SpgTissue::stable_time_step_ms() const {
   const double factor = options_.stabilization == Stabilization::penalty ? 1.0 + 4.0 * options_.stabilization_coefficient : 1.0;
   const double wave_speed = std::sqrt(material_.p_wave_modulus_MPa() * factor / material_.density_g_per_mm3());
-  const std::int64_t n = p_.size();
-  std::vector<double> dt(static_cast<size_t>(n), std::numeric_limits<double>::infinity());
-  parallel_for(n, [&](std::int64_t begin, std::int64_t end) {
-    for (std::int64_t i = begin; i < end; ++i) {
-      const size_t s = static_cast<size_t>(i);
-      if (!rk_.valid[s]) continue;
-      const Mat3d& F = p_.deformation_gradient[s];
-      Eigen::SelfAdjointEigenSolver<Mat3d> eig;
-      eig.computeDirect(F.transpose() * F, Eigen::EigenvaluesOnly);
-      const double min_stretch = std::sqrt(std::max(eig.eigenvalues()[0], 0.0));
-      dt[s] = stable_length_mm_[s] * min_stretch / wave_speed;
-    }
-  });
-  return options_.cfl * *std::min_element(dt.begin(), dt.end());
+  double shortest = std::numeric_limits<double>::infinity();  // current length of the shortest support
+  for (std::int64_t i = 0; i < p_.size(); ++i) {
+    const size_t s = static_cast<size_t>(i);
+    if (rk_.valid[s]) shortest = std::min(shortest, stable_length_mm_[s] * min_stretch_[s]);
+  }
+  return options_.cfl * shortest / wave_speed;
 }
 
 void SpgTissue::end_of_step() {
@@ -298,8 +304,10 @@ void SpgTissue::reinitialize_kernel() {
     if (rk_.valid[s]) p_.reference_volume_mm3[s] *= p_.deformation_gradient[s].determinant();
     p_.reference_mm[s] = p_.position_mm[s];
     p_.deformation_gradient[s].setIdentity();
+    min_stretch_[s] = 1.0;
   }
-  const Eigen::MatrixX3d X = reference_matrix();
+  refresh_reference_matrix();
+  const Eigen::MatrixX3d& X = reference_;
   const Eigen::Map<const Eigen::VectorXd> radius(p_.support_radius_mm.data(), n);
   NeighbourLists all = find_covering_centres(X, X, radius);
   NeighbourLists kept;

@@ -80,7 +80,7 @@ class SpgTissue {
   void apply_filter();
   void reinitialize_kernel();
   std::int64_t break_bonds();
-  Eigen::MatrixX3d reference_matrix() const;
+  void refresh_reference_matrix();
 
   TissueParticles p_;
   TissueMaterial material_;
@@ -89,6 +89,9 @@ class SpgTissue {
   BondNetwork bonds_;
   std::vector<double> stiffness_;  // kappa_i of the penalty
   std::vector<double> stable_length_mm_;  // min(spacing, nearest neighbour distance) in the kernel reference
+  std::vector<double> min_stretch_;       // smallest principal stretch of F, kept by compute_forces
+  std::vector<std::uint8_t> point_status_;  // scratch flags of compute_forces
+  Eigen::MatrixX3d reference_;            // #P by 3 copy of reference_mm for the shape-function builders
   std::vector<Vec3d> defect_;      // g_i
   std::vector<Mat3d> piola_volume_;  // V_i P_i
   std::int64_t steps_ = 0;
