@@ -163,4 +163,22 @@ TipGeometry resolve_tip(const GrindingRecipe& recipe) {
   return tip;
 }
 
+TipGeometry plain_rod_tip(double diameter_mm, double length_mm) {
+  NEEDLE_REQUIRE(std::isfinite(diameter_mm) && diameter_mm > 0, "rod diameter must be positive");
+  NEEDLE_REQUIRE(std::isfinite(length_mm) && length_mm > diameter_mm,
+                 fmt::format("rod length {} mm must exceed its diameter", length_mm));
+  TipGeometry tip;
+  tip.name = "rod";
+  tip.radius_mm = 0.5 * diameter_mm;
+  tip.base_x_mm = -length_mm;
+  FacetPlane end;
+  end.name = "end";
+  end.tilt_deg = 90.0;
+  end.normal = facet_outward_normal(90.0, 0.0);
+  end.point = Eigen::Vector3d::Zero();
+  tip.facets.push_back(end);
+  tip.tip_point = Eigen::Vector3d::Zero();
+  return tip;
+}
+
 }  // namespace needle

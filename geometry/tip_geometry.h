@@ -56,4 +56,8 @@ std::vector<Eigen::Vector3d> plane_pair_on_cylinder(const FacetPlane& a, const F
 // through-tip facets do not converge at the requested tip point.
 TipGeometry resolve_tip(const GrindingRecipe& recipe);
 
+// A flat-ended rod with no facets ground (the end face is tagged `end`, A is its centre): the
+// beam-theory check case for the needle's FE model.
+TipGeometry plain_rod_tip(double diameter_mm, double length_mm);
+
 }  // namespace needle

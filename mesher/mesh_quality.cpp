@@ -4,22 +4,10 @@
 #include <cmath>
 #include <limits>
 
+#include "mesher/tet_element.h"
+
 namespace needle {
 namespace {
-
-// Gradients of the shape functions with respect to (l1, l2, l3), with l0 = 1 - l1 - l2 - l3.
-// Corner a: N = l_a (2 l_a - 1); edge (a, b): N = 4 l_a l_b (VTK edge order).
-Eigen::Matrix<double, 10, 3> tet10_gradients(const Eigen::Vector4d& l) {
-  Eigen::Matrix<double, 4, 3> dl;  // d l_a / d (l1, l2, l3)
-  dl << -1, -1, -1, 1, 0, 0, 0, 1, 0, 0, 0, 1;
-  Eigen::Matrix<double, 10, 3> g;
-  for (int a = 0; a < 4; ++a) g.row(a) = (4 * l[a] - 1) * dl.row(a);
-  for (int e = 0; e < 6; ++e) {
-    const int a = kTet10EdgeCorners[e][0], b = kTet10EdgeCorners[e][1];
-    g.row(4 + e) = 4 * (l[a] * dl.row(b) + l[b] * dl.row(a));
-  }
-  return g;
-}
 
 Eigen::Matrix3d jacobian(const TetMesh& mesh, int t, const Eigen::Vector4d& l) {
   Eigen::Matrix3d J = Eigen::Matrix3d::Zero();  // columns: d x / d l1, d l2, d l3
@@ -27,7 +15,7 @@ Eigen::Matrix3d jacobian(const TetMesh& mesh, int t, const Eigen::Vector4d& l) {
     for (int k = 0; k < 3; ++k) J.col(k) = (mesh.X.row(mesh.T(t, k + 1)) - mesh.X.row(mesh.T(t, 0))).transpose();
     return J;
   }
-  const Eigen::Matrix<double, 10, 3> g = tet10_gradients(l);
+  const Eigen::MatrixXd g = tet_shape_gradients(2, l.tail<3>());
   for (int a = 0; a < 10; ++a) J += mesh.X.row(mesh.T(t, a)).transpose() * g.row(a);
   return J;
 }
@@ -105,6 +93,49 @@ std::vector<double> boundary_area_by_tag_mm2(const TetMesh& mesh) {
   return area;
 }
 
+namespace {
+
+// det J at corners, mid-edges and centroid over the straight tet's (1 for a straight tet).
+double scaled_jacobian(const TetMesh& mesh, int t, const std::vector<Eigen::Vector4d>& samples) {
+  const double straight = 6.0 * signed_tet_volume(node(mesh, mesh.T(t, 0)), node(mesh, mesh.T(t, 1)),
+                                                  node(mesh, mesh.T(t, 2)), node(mesh, mesh.T(t, 3)));
+  if (!(straight > 0)) return -1.0;
+  double worst = std::numeric_limits<double>::max();
+  for (const Eigen::Vector4d& s : samples) worst = std::min(worst, jacobian(mesh, t, s).determinant() / straight);
+  return worst;
+}
+
+std::vector<Eigen::Vector4d> jacobian_samples() {
+  std::vector<Eigen::Vector4d> samples;
+  for (int a = 0; a < 4; ++a) samples.push_back(Eigen::Vector4d::Unit(a));
+  for (const auto& e : kTet10EdgeCorners) samples.push_back(0.5 * (Eigen::Vector4d::Unit(e[0]) + Eigen::Vector4d::Unit(e[1])));
+  samples.push_back(Eigen::Vector4d::Constant(0.25));
+  return samples;
+}
+
+}  // namespace
+
+int straighten_distorted_tets(TetMesh& mesh, double min_scaled_jacobian) {
+  if (mesh.order != 2) return 0;
+  const std::vector<Eigen::Vector4d> samples = jacobian_samples();
+  std::vector<char> done(static_cast<size_t>(mesh.num_tets()), 0);
+  int straightened = 0;
+  for (int pass = 0; pass < 10; ++pass) {
+    int changed = 0;
+    for (int t = 0; t < mesh.num_tets(); ++t) {
+      if (done[static_cast<size_t>(t)] || scaled_jacobian(mesh, t, samples) >= min_scaled_jacobian) continue;
+      for (int e = 0; e < 6; ++e)
+        mesh.X.row(mesh.T(t, 4 + e)) =
+            0.5 * (mesh.X.row(mesh.T(t, kTet10EdgeCorners[e][0])) + mesh.X.row(mesh.T(t, kTet10EdgeCorners[e][1])));
+      done[static_cast<size_t>(t)] = 1;
+      ++changed;
+    }
+    straightened += changed;
+    if (changed == 0) break;
+  }
+  return straightened;
+}
+
 MeshQuality measure_quality(const TetMesh& mesh) {
   MeshQuality q;
   q.order = mesh.order;
@@ -114,10 +145,7 @@ MeshQuality measure_quality(const TetMesh& mesh) {
   q.min_radius_ratio = q.min_dihedral_deg = q.min_scaled_jacobian = q.min_edge_mm = std::numeric_limits<double>::max();
   double sum_ratio = 0, sum_edge = 0;
   // Sample points for det J: corners, mid-edges, centroid.
-  std::vector<Eigen::Vector4d> samples;
-  for (int a = 0; a < 4; ++a) samples.push_back(Eigen::Vector4d::Unit(a));
-  for (const auto& e : kTet10EdgeCorners) samples.push_back(0.5 * (Eigen::Vector4d::Unit(e[0]) + Eigen::Vector4d::Unit(e[1])));
-  samples.push_back(Eigen::Vector4d::Constant(0.25));
+  const std::vector<Eigen::Vector4d> samples = jacobian_samples();
 
   for (int t = 0; t < mesh.num_tets(); ++t) {
     Eigen::Vector3d p[4];

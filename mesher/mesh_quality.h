@@ -29,6 +29,12 @@ double tet_mesh_volume_mm3(const TetMesh& mesh);
 // Area of the boundary faces per tag (6-node faces by a degree-5 rule).
 std::vector<double> boundary_area_by_tag_mm2(const TetMesh& mesh);
 
+// Makes every T10 tet whose scaled Jacobian is below the threshold straight-sided (its mid-edge nodes
+// move to the edge midpoints; neighbours sharing those edges see them straight too), repeating until
+// none is left. Curving edges onto the cylinder can fold thin boundary tets; a straight edge costs a
+// chord sag of h^2 / 8R on the surface instead. Returns how many tets were straightened.
+int straighten_distorted_tets(TetMesh& mesh, double min_scaled_jacobian);
+
 // Position of the point with barycentric coordinates (l0, l1, l2, l3) in tet t (isoparametric).
 Eigen::Vector3d tet_point(const TetMesh& mesh, int t, const Eigen::Vector4d& barycentric);
 

@@ -12,6 +12,7 @@
 #include "geometry/input_error.h"
 #include "mesher/gmsh_model_mesh.h"
 #include "mesher/gmsh_session.h"
+#include "mesher/mesh_quality.h"
 
 namespace needle {
 namespace {
@@ -216,7 +217,7 @@ void generate(const NeedleMeshOptions& o) {
   gmsh::model::mesh::generate(3);
   if (o.order == 1) return;
   gmsh::model::mesh::setOrder(2);
-  if (!o.optimize) return;
+  if (!o.optimize || !o.high_order_optimize) return;
   try {
     gmsh::model::mesh::optimize("HighOrder");
   } catch (const std::string&) {
@@ -239,6 +240,7 @@ NeedleMeshOptions NeedleMeshOptions::resolved() const {
   NEEDLE_REQUIRE(o.shaft_size_mm >= o.size_mm, "mesh option shaft_size_mm must not be smaller than size_mm");
   NEEDLE_REQUIRE(elements_per_circle >= 0 && elements_per_circle <= 360, "elements_per_circle must be in [0, 360]");
   NEEDLE_REQUIRE(threads >= 0, "threads must not be negative");
+  NEEDLE_REQUIRE(min_scaled_jacobian >= 0 && min_scaled_jacobian < 1, "min_scaled_jacobian must lie in [0, 1)");
   return o;
 }
 
@@ -290,6 +292,7 @@ TetMesh mesh_needle(const TipGeometry& tip, bool half_model, const NeedleMeshOpt
     mesh = detail::extract_tet_mesh(o.order, surface_tag, tag_names);
   });
   if (mesh.num_tets() == 0) throw std::runtime_error("mesher: gmsh produced no tetrahedra");
+  mesh.straightened_tets = straighten_distorted_tets(mesh, o.min_scaled_jacobian);
   return mesh;
 }
 

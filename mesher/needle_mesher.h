@@ -25,6 +25,8 @@ struct NeedleMeshOptions {
   int elements_per_circle = 0;    // gmsh curvature sizing on the shaft (0: off)
   int threads = 1;                // 1: gmsh Delaunay, same mesh every run; else HXT on that many threads (0: all)
   bool optimize = true;           // gmsh tet optimisation (and T10 high-order optimisation) after meshing
+  bool high_order_optimize = true;  // gmsh's T10 optimiser: better curved tets, but slow on coarse shafts
+  double min_scaled_jacobian = 0.02; // T10 tets still below this are straightened (mesh_quality.h)
 
   // The sizes with defaults filled in; InputError for unphysical values.
   NeedleMeshOptions resolved() const;

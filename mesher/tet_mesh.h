@@ -22,6 +22,7 @@ struct TetMesh {
   Eigen::MatrixXi boundary_faces;      // #B by 3 or 6 node indices
   Eigen::VectorXi boundary_tag;        // #B index into tag_names
   std::vector<std::string> tag_names;  // CAD face names: top, bottom, ..., shaft, base, symmetry
+  int straightened_tets = 0;           // T10 tets the mesher made straight-sided (curving folded them)
 
   int num_nodes() const { return static_cast<int>(X.rows()); }
   int num_tets() const { return static_cast<int>(T.rows()); }

@@ -14,6 +14,7 @@ PACKAGES=(
   catch2
   nlohmann-json3-dev libcli11-dev libfmt-dev libspdlog-dev
   libpng-dev libfreetype-dev fonts-dejavu-core
+  libsuitesparse-dev libspectra-dev
 )
 missing=()
 for p in "${PACKAGES[@]}"; do

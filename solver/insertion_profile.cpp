@@ -1,0 +1,37 @@
+#include "solver/insertion_profile.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+
+#include "geometry/input_error.h"
+
+namespace needle {
+
+void InsertionProfile::validate(const std::string& where) const {
+  NEEDLE_REQUIRE(std::isfinite(accel_time_ms) && accel_time_ms >= 0,
+                 fmt::format("{}: accel_time_ms must be zero or positive (got {})", where, accel_time_ms));
+  NEEDLE_REQUIRE(std::isfinite(speed_mm_per_ms) && speed_mm_per_ms > 0,
+                 fmt::format("{}: the insertion speed must be positive (got {} m/s)", where, speed_mm_per_ms));
+  NEEDLE_REQUIRE(std::isfinite(travel_mm) && travel_mm > 0, fmt::format("{}: travel_mm must be positive (got {})", where, travel_mm));
+  NEEDLE_REQUIRE(travel_mm >= 0.5 * speed_mm_per_ms * accel_time_ms,
+                 fmt::format("{}: travel {} mm ends before the speed is reached ({} mm of ramp)", where, travel_mm,
+                             0.5 * speed_mm_per_ms * accel_time_ms));
+}
+
+double InsertionProfile::end_time_ms() const {
+  return accel_time_ms + (travel_mm - 0.5 * speed_mm_per_ms * accel_time_ms) / speed_mm_per_ms;
+}
+
+double InsertionProfile::velocity_mm_per_ms(double t) const {
+  if (t <= 0 || t >= end_time_ms()) return 0.0;
+  return t < accel_time_ms ? speed_mm_per_ms * t / accel_time_ms : speed_mm_per_ms;
+}
+
+double InsertionProfile::displacement_mm(double t) const {
+  t = std::clamp(t, 0.0, end_time_ms());
+  if (t < accel_time_ms) return 0.5 * speed_mm_per_ms * t * t / accel_time_ms;
+  return 0.5 * speed_mm_per_ms * accel_time_ms + speed_mm_per_ms * (t - accel_time_ms);
+}
+
+}  // namespace needle
