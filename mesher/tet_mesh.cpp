@@ -4,6 +4,8 @@
 #include <map>
 #include <stdexcept>
 
+#include "geometry/input_error.h"
+
 namespace needle {
 
 int TetMesh::tag_index(const std::string& name) const {
@@ -92,6 +94,53 @@ void drop_unused_nodes(TetMesh& mesh) {
       mesh.boundary_faces(b, c) = n;
     }
   mesh.X = std::move(X);
+}
+
+TetMesh mirrored_union(const TetMesh& half, int axis) {
+  NEEDLE_REQUIRE(axis >= 0 && axis < 3, "mirror axis must be 0, 1 or 2");
+  const double scale = std::max(1.0, half.X.cwiseAbs().maxCoeff());
+  const double on_plane = 1e-9 * scale;
+  const int n = half.num_nodes();
+  NEEDLE_REQUIRE(half.X.col(axis).minCoeff() >= -on_plane, "mirrored_union: the half model has nodes on both sides of the plane");
+  // Node i of the mirror is i itself on the plane, else a new node.
+  std::vector<int> image(static_cast<size_t>(n));
+  int count = n;
+  for (int i = 0; i < n; ++i) image[static_cast<size_t>(i)] = std::abs(half.X(i, axis)) <= on_plane ? i : count++;
+  TetMesh full;
+  full.order = half.order;
+  full.tag_names = half.tag_names;
+  full.X.resize(count, 3);
+  full.X.topRows(n) = half.X;
+  for (int i = 0; i < n; ++i) {
+    if (image[static_cast<size_t>(i)] == i) {
+      full.X(i, axis) = 0.0;
+      continue;
+    }
+    full.X.row(image[static_cast<size_t>(i)]) = half.X.row(i);
+    full.X(image[static_cast<size_t>(i)], axis) = -half.X(i, axis);
+  }
+  auto mirrored_cells = [&](const Eigen::MatrixXi& cells) {
+    Eigen::MatrixXi m(cells.rows(), cells.cols());
+    for (Eigen::Index r = 0; r < cells.rows(); ++r)
+      for (Eigen::Index k = 0; k < cells.cols(); ++k) m(r, k) = image[static_cast<size_t>(cells(r, k))];
+    return m;
+  };
+  full.T.resize(2 * half.num_tets(), half.T.cols());
+  full.T << half.T, mirrored_cells(half.T);
+  const int symmetry = half.tag_index("symmetry");
+  std::vector<int> kept;
+  for (int f = 0; f < half.num_boundary_faces(); ++f)
+    if (half.boundary_tag[f] != symmetry) kept.push_back(f);
+  const int nf = static_cast<int>(kept.size());
+  full.boundary_faces.resize(2 * nf, half.boundary_faces.cols());
+  full.boundary_tag.resize(2 * nf);
+  for (int k = 0; k < nf; ++k) {
+    full.boundary_faces.row(k) = half.boundary_faces.row(kept[static_cast<size_t>(k)]);
+    full.boundary_tag[k] = full.boundary_tag[nf + k] = half.boundary_tag[kept[static_cast<size_t>(k)]];
+  }
+  full.boundary_faces.bottomRows(nf) = mirrored_cells(full.boundary_faces.topRows(nf));
+  orient_tet_mesh(full);  // the mirror images are inside out until re-oriented
+  return full;
 }
 
 }  // namespace needle

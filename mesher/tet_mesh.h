@@ -45,6 +45,12 @@ double signed_tet_volume(const Eigen::Vector3d& a, const Eigen::Vector3d& b, con
 // bounds no tet, which would mean the mesh and its boundary disagree.
 void orient_tet_mesh(TetMesh& mesh);
 
+// The union of a half model (all nodes on one side of the plane x_axis = 0, its plane faces tagged
+// `symmetry`) and its mirror image: a full mesh that is exactly mirror-symmetric, so that anything
+// symmetric stays symmetric to round-off in a simulation on it. Nodes on the plane are shared; the
+// `symmetry` faces are dropped. InputError if a node lies on the wrong side.
+TetMesh mirrored_union(const TetMesh& half, int axis);
+
 // Drops nodes no tet uses and renumbers the rest (gmsh keeps geometry points that may be unused).
 void drop_unused_nodes(TetMesh& mesh);
 

@@ -24,7 +24,7 @@ double InsertionProfile::end_time_ms() const {
 }
 
 double InsertionProfile::velocity_mm_per_ms(double t) const {
-  if (t <= 0 || t >= end_time_ms()) return 0.0;
+  if (t <= 0 || t > end_time_ms()) return 0.0;  // still moving at the end of the travel
   return t < accel_time_ms ? speed_mm_per_ms * t / accel_time_ms : speed_mm_per_ms;
 }
 

@@ -14,7 +14,7 @@ struct InsertionProfile {
   // InputError naming the field for non-positive values or a travel shorter than the ramp.
   void validate(const std::string& where = "motion") const;
   double end_time_ms() const;
-  double velocity_mm_per_ms(double time_ms) const;
+  double velocity_mm_per_ms(double time_ms) const;  // the speed up to and at the end time, 0 after
   double displacement_mm(double time_ms) const;  // exact integral of the velocity
 };
 

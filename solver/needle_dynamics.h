@@ -1,0 +1,86 @@
+#pragma once
+// Explicit central-difference dynamics of the FE needle (velocity Verlet form, velocities at full
+// steps for the energy balance), with the supports of an insertion: clamped nodes, a symmetry plane,
+// the base plane driven by the insertion profile, and the rigid cannula.
+//   v(n+1/2) = v(n) + dt/2 a(n);  supports;  x(n+1) = x(n) + dt v(n+1/2);
+//   forces at x(n+1) (elastic + cannula);  v(n+1) = v(n+1/2) + dt/2 a(n+1);  supports.
+// Driven nodes follow X + d(t) direction exactly. Energy balance:
+//   kinetic + strain - (initial) = work of the drive's reaction + work of the cannula,
+// whose relative error is the integrator's drift. The run stops with a SolverError (never NaN) on a
+// non-finite state, on energy drift beyond a bound, or on cannula penetration beyond a bound.
+#include <Eigen/Dense>
+#include <optional>
+#include <vector>
+
+#include "solver/fe_needle.h"
+#include "solver/insertion_profile.h"
+#include "solver/rigid_cannula.h"
+
+namespace needle {
+
+struct NeedleSupports {
+  std::vector<int> clamped;   // all components held at zero velocity
+  std::vector<int> symmetry;  // v_z = 0 (half model, z = 0 plane)
+  std::vector<int> driven;    // follow the profile along direction
+  InsertionProfile profile;
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
+};
+
+struct NeedleDynamicsOptions {
+  double courant = 0.9;                 // fraction of the stable step used
+  double max_energy_error = 0.05;       // stop when the balance error exceeds this (after the first work)
+  double max_penetration_mm = 0.05;     // stop when a node passes the cannula's bore by more
+};
+
+struct NeedleEnergy {
+  double kinetic_mJ = 0, strain_mJ = 0, initial_mJ = 0;
+  double drive_work_mJ = 0, cannula_work_mJ = 0;
+  // |KE + U - E0 - W_drive - W_cannula| / the largest of those terms.
+  double balance_error() const;
+};
+
+class NeedleDynamics {
+ public:
+  NeedleDynamics(const FeNeedle& needle, NeedleSupports supports, const std::optional<CannulaOptions>& cannula,
+                 const NeedleDynamicsOptions& options = {});
+
+  double time_step_ms() const { return dt_ms_; }
+  // Replaces the state before the first step (a pre-deformed or moving start); InputError after.
+  void set_initial_state(const Eigen::MatrixX3d& x_mm, const Eigen::MatrixX3d& v_mm_per_ms);
+  // One step of time_step_ms() (shortened to land on end_time_ms if given).
+  void step(double end_time_ms = std::numeric_limits<double>::infinity());
+
+  double time_ms() const { return time_ms_; }
+  long steps() const { return steps_; }
+  const Eigen::MatrixX3d& positions_mm() const { return x_; }
+  const Eigen::MatrixX3d& velocities_mm_per_ms() const { return v_; }
+  Eigen::MatrixX3d displacements_mm() const { return x_ - needle_.mesh().X; }
+  const NeedleEnergy& energy() const { return energy_; }
+  const CannulaContact& cannula_contact() const { return contact_; }
+  // Force the drive applies to the needle through the driven nodes (N): m a - f over those nodes.
+  Eigen::Vector3d drive_reaction_N() const { return drive_reaction_; }
+  // Where the driven base has moved the needle rigidly: d(t) direction.
+  Eigen::Vector3d drive_displacement_mm() const { return supports_.profile.displacement_mm(time_ms_) * supports_.direction; }
+  const FeNeedle& needle() const { return needle_; }
+
+ private:
+  void apply_supports(Eigen::MatrixX3d& v, double time_ms) const;
+  void compute_forces(const Eigen::MatrixX3d& velocity);
+
+  const FeNeedle& needle_;
+  NeedleSupports supports_;
+  std::optional<RigidCannula> cannula_;
+  NeedleDynamicsOptions options_;
+  double dt_ms_ = 0, time_ms_ = 0;
+  long steps_ = 0;
+  Eigen::MatrixX3d x_, v_, a_, force_, old_force_, cannula_force_, old_cannula_force_;
+  Eigen::MatrixX3d v_before_, v_half_;  // step scratch
+  Eigen::VectorXd mass_;
+  std::vector<std::uint8_t> mask_;  // per node: bit k = component k prescribed
+  std::vector<int> constrained_;
+  NeedleEnergy energy_;
+  CannulaContact contact_;
+  Eigen::Vector3d drive_reaction_ = Eigen::Vector3d::Zero();
+};
+
+}  // namespace needle
