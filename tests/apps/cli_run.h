@@ -13,8 +13,9 @@ struct Result {
   std::string out;
 };
 
-inline Result run(const std::string& args) {
-  const std::string command = std::string(NEEDLE_BINARY) + " " + args + " 2>/dev/null";
+// stdout only, or stdout and stderr together (to read error messages).
+inline Result run(const std::string& args, bool with_stderr = false) {
+  const std::string command = std::string(NEEDLE_BINARY) + " " + args + (with_stderr ? " 2>&1" : " 2>/dev/null");
   FILE* pipe = popen(command.c_str(), "r");
   REQUIRE(pipe);
   std::string out;

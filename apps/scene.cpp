@@ -1,0 +1,170 @@
+#include "apps/scene.h"
+
+#include <filesystem>
+#include <fmt/format.h>
+
+#include "apps/json_lines.h"
+#include "apps/material_json.h"
+#include "apps/scene_object.h"
+#include "geometry/input_error.h"
+
+namespace needle {
+namespace {
+
+using nlohmann::json;
+
+void read_needle(SceneObject o, NeedleScene& n, const std::string& scene_folder) {
+  n.preset = o.text("preset", "");
+  n.d_a_mm = o.quantity("d_a", Dimension::length, n.d_a_mm, any_finite());
+  n.recipe_file = o.text("recipe", "");
+  n.mesh_file = o.text("mesh_file", "");
+  n.plain_rod = o.boolean("plain_rod", false);
+  const int sources = !n.preset.empty() + !std::isnan(n.d_a_mm) + !n.recipe_file.empty() + !n.mesh_file.empty() + n.plain_rod;
+  NEEDLE_REQUIRE(sources <= 1, fmt::format("{}: give one of preset, d_a_mm, recipe, mesh_file or plain_rod", o.where("preset")));
+  if (sources == 0) n.preset = "SB";
+  for (std::string* file : {&n.recipe_file, &n.mesh_file}) {
+    if (file->empty()) continue;
+    const std::string key = file == &n.recipe_file ? "recipe" : "mesh_file";
+    std::filesystem::path p(*file);
+    if (p.is_relative()) p = std::filesystem::path(scene_folder) / p;
+    NEEDLE_REQUIRE(std::filesystem::is_regular_file(p), fmt::format("{}: file '{}' does not exist", o.where(key), p.string()));
+    *file = p.string();
+  }
+  n.length_mm = o.quantity("length", Dimension::length, n.length_mm, positive());
+  n.half_model = o.boolean("half_model", n.half_model);
+  if (o.has("mesh")) {
+    SceneObject m = o.child("mesh");
+    n.mesh.order = m.integer("order", n.mesh.order, 1, 2);
+    n.mesh.size_mm = m.quantity("size", Dimension::length, n.mesh.size_mm, positive());
+    n.mesh.tip_size_mm = m.quantity("tip_size", Dimension::length, n.mesh.tip_size_mm, non_negative());
+    n.mesh.edge_size_mm = m.quantity("edge_size", Dimension::length, n.mesh.edge_size_mm, non_negative());
+    n.mesh.shaft_size_mm = m.quantity("shaft_size", Dimension::length, n.mesh.shaft_size_mm, non_negative());
+    n.mesh.grading_mm = m.quantity("grading", Dimension::length, n.mesh.grading_mm, positive());
+    m.finish();
+    try {
+      n.mesh.resolved();
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("{}: {}", o.where("mesh"), e.what()));
+    }
+  }
+  if (o.has("material")) {
+    SceneObject m = o.child("material");
+    n.material.youngs_modulus_MPa = m.quantity("youngs_modulus", Dimension::stress, n.material.youngs_modulus_MPa, positive());
+    n.material.poisson_ratio = m.number("poisson_ratio", n.material.poisson_ratio, within(-0.999, 0.499));
+    n.material.density_g_per_mm3 = m.quantity("density", Dimension::density, n.material.density_g_per_mm3, positive());
+    m.finish();
+  }
+  o.finish();
+}
+
+void read_motion(SceneObject o, Scene& s) {
+  InsertionProfile& p = s.motion;
+  p.accel_time_ms = o.quantity("accel_time", Dimension::time, p.accel_time_ms, non_negative());
+  p.speed_mm_per_ms = o.quantity("speed", Dimension::speed, p.speed_mm_per_ms, positive());
+  p.travel_mm = o.quantity("travel", Dimension::length, p.travel_mm, positive());
+  s.direction = o.vector3("direction", s.direction);
+  NEEDLE_REQUIRE(s.direction.allFinite() && s.direction.norm() > 0, fmt::format("{} must be a non-zero vector", o.where("direction")));
+  try {
+    p.validate("motion");
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("{}: {}", o.where("travel_mm"), e.what()));
+  }
+  o.finish();
+}
+
+void read_cannula(SceneObject o, CannulaOptions& c) {
+  c.enabled = o.boolean("enabled", c.enabled);
+  c.outer_diameter_mm = o.quantity("outer_diameter", Dimension::length, c.outer_diameter_mm, positive());
+  c.wall_mm = o.quantity("wall", Dimension::length, c.wall_mm, positive());
+  c.front_x_mm = o.quantity("front_x", Dimension::length, c.front_x_mm, any_finite());
+  c.length_mm = o.quantity("length", Dimension::length, c.length_mm, positive());
+  c.friction = o.number("friction", c.friction, non_negative());
+  c.penalty_scale = o.number("penalty_scale", c.penalty_scale, within(1e-6, 0.5));
+  NEEDLE_REQUIRE(c.wall_mm < 0.5 * c.outer_diameter_mm, fmt::format("{}: the wall leaves no bore", o.where("wall_mm")));
+  o.finish();
+}
+
+void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc) {
+  t.enabled = o.boolean("enabled", t.enabled);
+  t.size_mm = o.vector3("size_mm", t.size_mm);
+  NEEDLE_REQUIRE((t.size_mm.array() > 0).all(), fmt::format("{} must be three positive lengths", o.where("size_mm")));
+  t.spacing_mm = o.quantity("spacing", Dimension::length, t.spacing_mm, positive());
+  t.dilation = o.number("dilation", t.dilation, within(1.0, 4.0));
+  t.friction = o.number("friction", t.friction, non_negative());
+  if (o.has("material")) t.material = material_from_json(o.raw("material"), doc.where("/tissue/material"), t.material);
+  t.material.validate();
+  o.finish();
+}
+
+void read_solver(SceneObject o, SolverScene& s) {
+  s.courant = o.number("courant", s.courant, within(1e-3, 1.0));
+  s.mass_scaling_dt_ms = o.quantity("mass_scaling_dt", Dimension::time, s.mass_scaling_dt_ms, non_negative());
+  s.max_energy_error = o.number("max_energy_error", s.max_energy_error, positive());
+  s.max_penetration_mm = o.quantity("max_penetration", Dimension::length, s.max_penetration_mm, positive());
+  s.threads = o.integer("threads", s.threads, 0, 1024);
+  o.finish();
+}
+
+void read_output(SceneObject o, OutputScene& out) {
+  out.history_interval_ms = o.quantity("history_interval", Dimension::time, out.history_interval_ms, positive());
+  out.frames = o.integer("frames", out.frames, 0, 10000);
+  o.finish();
+}
+
+Scene scene_from_document(const JsonDocument& doc) {
+  Scene s;
+  s.source = doc.source;
+  const std::string folder = std::filesystem::path(doc.source).parent_path().string();
+  SceneObject root(doc, "", "");
+  if (root.has("needle")) read_needle(root.child("needle"), s.needle, folder);
+  else s.needle.preset = "SB";
+  if (root.has("motion")) read_motion(root.child("motion"), s);
+  if (root.has("cannula")) read_cannula(root.child("cannula"), s.cannula);
+  if (root.has("tissue")) read_tissue(root.child("tissue"), s.tissue, doc);
+  if (root.has("solver")) read_solver(root.child("solver"), s.solver);
+  if (root.has("output")) read_output(root.child("output"), s.output);
+  root.text("description", "");
+  root.finish();
+  return s;
+}
+
+json vector_json(const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); }
+
+}  // namespace
+
+Scene parse_scene(const std::string& text, const std::string& source) {
+  return scene_from_document(parse_json_with_lines(text, source));
+}
+
+Scene read_scene(const std::string& path) { return scene_from_document(read_json_with_lines(path)); }
+
+json scene_to_json(const Scene& s) {
+  const NeedleScene& n = s.needle;
+  json needle = {{"length_mm", n.length_mm}, {"half_model", n.half_model}};
+  if (!n.preset.empty()) needle["preset"] = n.preset;
+  if (!std::isnan(n.d_a_mm)) needle["d_a_mm"] = n.d_a_mm;
+  if (!n.recipe_file.empty()) needle["recipe"] = std::filesystem::absolute(n.recipe_file).string();
+  if (!n.mesh_file.empty()) needle["mesh_file"] = std::filesystem::absolute(n.mesh_file).string();
+  if (n.plain_rod) needle["plain_rod"] = true;
+  needle["mesh"] = {{"order", n.mesh.order}, {"size_mm", n.mesh.size_mm}, {"tip_size_mm", n.mesh.tip_size_mm},
+                    {"edge_size_mm", n.mesh.edge_size_mm}, {"shaft_size_mm", n.mesh.shaft_size_mm}, {"grading_mm", n.mesh.grading_mm}};
+  needle["material"] = {{"youngs_modulus_MPa", n.material.youngs_modulus_MPa}, {"poisson_ratio", n.material.poisson_ratio},
+                        {"density_g_per_cm3", n.material.density_g_per_mm3 * 1e3}};
+  const CannulaOptions& c = s.cannula;
+  return {
+      {"needle", needle},
+      {"motion", {{"accel_time_ms", s.motion.accel_time_ms}, {"speed_m_per_s", s.motion.speed_mm_per_ms},
+                  {"travel_mm", s.motion.travel_mm}, {"direction", vector_json(s.direction)}}},
+      {"cannula", {{"enabled", c.enabled}, {"outer_diameter_mm", c.outer_diameter_mm}, {"wall_mm", c.wall_mm},
+                   {"front_x_mm", c.front_x_mm}, {"length_mm", c.length_mm}, {"friction", c.friction},
+                   {"penalty_scale", c.penalty_scale}}},
+      {"tissue", {{"enabled", s.tissue.enabled}, {"size_mm", vector_json(s.tissue.size_mm)}, {"spacing_mm", s.tissue.spacing_mm},
+                  {"dilation", s.tissue.dilation}, {"friction", s.tissue.friction}, {"material", material_to_json(s.tissue.material)}}},
+      {"solver", {{"courant", s.solver.courant}, {"mass_scaling_dt_ms", s.solver.mass_scaling_dt_ms},
+                  {"max_energy_error", s.solver.max_energy_error}, {"max_penetration_mm", s.solver.max_penetration_mm},
+                  {"threads", s.solver.threads}}},
+      {"output", {{"history_interval_ms", s.output.history_interval_ms}, {"frames", s.output.frames}}},
+  };
+}
+
+}  // namespace needle

@@ -1,0 +1,68 @@
+#pragma once
+// A simulation scene: every parameter of the paper scene (shared/SPEC.md), with the paper's values as
+// defaults, read from JSON. Keys carry their unit ("travel_mm": 30); a key without its unit suffix
+// takes a string with a unit ("travel": "3 cm"); a bare number where a unit is needed, an unknown
+// key, or an unphysical value is refused with the file, line and key (docs/scenes.md).
+#include <Eigen/Dense>
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "mesher/needle_mesher.h"
+#include "solver/insertion_profile.h"
+#include "solver/needle_material.h"
+#include "solver/rigid_cannula.h"
+#include "solver/tissue_material.h"
+
+namespace needle {
+
+struct NeedleScene {
+  // Exactly one source; none given means the paper's SB preset.
+  std::string preset, recipe_file, mesh_file;
+  double d_a_mm = std::nan("");
+  bool plain_rod = false;
+  double length_mm = 40.0;  // modelled length from tip point A back to the driven base plane
+  bool half_model = true;   // z >= 0 half with a symmetry plane (paper)
+  NeedleMeshOptions mesh;   // T10, 0.2 mm (paper)
+  NeedleMaterial material;  // AISI 304
+};
+
+struct TissueScene {  // read and checked; the coupled run comes with the L-SPG solver
+  bool enabled = false;
+  Eigen::Vector3d size_mm{40.0, 8.0, 2.0};
+  double spacing_mm = 0.4, dilation = 1.8, friction = 0.18;
+  TissueMaterial material;
+};
+
+struct SolverScene {
+  double courant = 0.9;
+  double mass_scaling_dt_ms = 0.0;  // 0: off
+  double max_energy_error = 0.05;
+  double max_penetration_mm = 0.05;
+  int threads = 0;
+};
+
+struct OutputScene {
+  double history_interval_ms = 0.01;
+  int frames = 20;  // ParaView frames over the run (plus the start)
+};
+
+struct Scene {
+  std::string source;  // the file it came from
+  NeedleScene needle;
+  InsertionProfile motion;
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
+  CannulaOptions cannula;
+  TissueScene tissue;
+  SolverScene solver;
+  OutputScene output;
+};
+
+// InputError with file, line and key for anything wrong.
+Scene read_scene(const std::string& path);
+Scene parse_scene(const std::string& text, const std::string& source);
+
+// The effective scene, every key with its canonical unit suffix; reading it back gives the same scene.
+nlohmann::json scene_to_json(const Scene& scene);
+
+}  // namespace needle

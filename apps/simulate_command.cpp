@@ -1,0 +1,243 @@
+// `needle simulate SCENE --out DIR`: builds the needle a scene describes, drives it through the
+// cannula with the scene's profile and writes the run folder:
+//   scene.json (the effective scene), history.csv, summary.json, needle.pvd + frames/*.vtu, run.log.
+#include "apps/simulate_command.h"
+
+#include <chrono>
+#include <fmt/format.h>
+#include <fstream>
+#include <iostream>
+#include <sys/resource.h>
+
+#include "apps/needle_build.h"
+#include "apps/recipe_json.h"
+#include "apps/run_folder.h"
+#include "apps/scene.h"
+#include "geometry/grinding_recipe.h"
+#include "geometry/input_error.h"
+#include "mesher/msh_file.h"
+#include "mesher/vtk_files.h"
+#include "solver/needle_dynamics.h"
+#include "solver/needle_stiffness.h"
+#include "solver/parallel.h"
+#include "solver/solver_error.h"
+
+namespace needle {
+namespace {
+
+using nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+struct SimulateOptions {
+  std::string scene_file, out_dir;
+  bool overwrite = false, quiet = false;
+  int threads = -1;
+};
+
+// The mesh, its tip point A and its name, from the scene's needle section.
+struct SceneNeedle {
+  std::string name;
+  TetMesh mesh;
+  Eigen::Vector3d tip_point = Eigen::Vector3d::Zero();
+  double mesh_seconds = 0;
+};
+
+SceneNeedle build_scene_needle(const NeedleScene& n) {
+  SceneNeedle out;
+  if (!n.mesh_file.empty()) {
+    out.name = n.mesh_file;
+    out.mesh = read_msh(n.mesh_file);
+    Eigen::Index distal = 0;
+    out.mesh.X.col(0).maxCoeff(&distal);  // A: the most distal node
+    out.tip_point = out.mesh.X.row(distal).transpose();
+    return out;
+  }
+  TipGeometry tip;
+  if (n.plain_rod) {
+    tip = plain_rod_tip(1.0, n.length_mm);
+  } else {
+    GrindingRecipe recipe = !n.preset.empty() ? preset_recipe(n.preset)
+                            : !n.recipe_file.empty() ? read_recipe_file(n.recipe_file)
+                                                     : multi_bevel_recipe(n.d_a_mm);
+    recipe.rod.length_mm = n.length_mm;
+    tip = resolve_tip(recipe);
+  }
+  NeedleMeshOptions mesh_options = n.mesh;
+  mesh_options.high_order_optimize = false;  // slow on coarse shafts; folded tets are straightened instead
+  const NeedleBuild build = build_needle(tip, n.half_model, mesh_options);
+  out.name = tip.name;
+  out.mesh = build.mesh;
+  out.tip_point = tip.tip_point;
+  out.mesh_seconds = build.mesh_seconds;
+  return out;
+}
+
+double peak_memory_MiB() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;
+}
+
+void write_frame(const RunFolder& folder, const NeedleDynamics& run, int index, std::vector<std::pair<double, std::string>>& frames) {
+  TetMesh deformed = run.needle().mesh();
+  deformed.X = run.positions_mm();
+  const ElementStresses stresses = run.needle().element_stresses(run.positions_mm());
+  const std::string name = fmt::format("frames/needle_{:04}.vtu", index);
+  write_vtu(folder.path(name).string(), deformed,
+            {{"von_mises_MPa", stresses.von_mises_MPa}, {"cauchy_stress_MPa", stresses.cauchy_MPa}},
+            {{"displacement_mm", run.displacements_mm()}, {"velocity_m_per_s", run.velocities_mm_per_ms()}});
+  frames.emplace_back(run.time_ms(), name);
+}
+
+void write_pvd(const std::filesystem::path& path, const std::vector<std::pair<double, std::string>>& frames) {
+  std::ofstream out(path);
+  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n";
+  for (const auto& [time, file] : frames) out << fmt::format("    <DataSet timestep=\"{:.9g}\" file=\"{}\"/>\n", time, file);
+  out << "  </Collection>\n</VTKFile>\n";
+}
+
+void run_simulation(const SimulateOptions& o) {
+  // Everything that can be wrong with the input is found before the run folder exists.
+  const Scene scene = read_scene(o.scene_file);
+  NEEDLE_REQUIRE(!scene.tissue.enabled,
+                 fmt::format("{}: tissue.enabled: the coupled needle-tissue (L-SPG) run is not in this version; "
+                             "set it to false to run the needle and cannula alone", scene.source));
+  const ThreadLimit threads(o.threads >= 0 ? o.threads : scene.solver.threads);
+  RunFolder folder(o.out_dir, o.overwrite);
+  std::filesystem::create_directories(folder.path("frames"));
+  RunLog log(folder.path("run.log"));
+  {
+    std::ofstream effective(folder.path("scene.json"));
+    effective << scene_to_json(scene).dump(2) << "\n";
+  }
+  log.line(fmt::format("scene {}", scene.source));
+
+  const auto start = Clock::now();
+  const SceneNeedle built = build_scene_needle(scene.needle);
+  log.line(fmt::format("needle {}: {} T{} elements, {} nodes, meshed in {:.2f} s", built.name, built.mesh.num_tets(),
+                       built.mesh.order == 2 ? 10 : 4, built.mesh.num_nodes(), built.mesh_seconds));
+  const FeNeedle needle(built.mesh, scene.needle.material, scene.solver.mass_scaling_dt_ms);
+  log.line(fmt::format("stable step {:.4g} ms (unscaled {:.4g} ms); mass {:.5g} g, added by mass scaling {:.3g} % in {} elements",
+                       needle.stable_time_step_ms(), needle.unscaled_time_step_ms(), needle.physical_mass_g(),
+                       100 * needle.added_mass_g() / needle.physical_mass_g(), needle.mass_scaled_elements()));
+
+  NeedleSupports supports;
+  supports.driven = nodes_with_tag(needle.mesh(), "base");
+  if (needle.mesh().tag_index("symmetry") >= 0) supports.symmetry = nodes_with_tag(needle.mesh(), "symmetry");
+  supports.profile = scene.motion;
+  supports.direction = scene.direction;
+  NeedleDynamicsOptions dynamics;
+  dynamics.courant = scene.solver.courant;
+  dynamics.max_energy_error = scene.solver.max_energy_error;
+  dynamics.max_penetration_mm = scene.solver.max_penetration_mm;
+  NeedleDynamics run(needle, supports, scene.cannula.enabled ? std::optional<CannulaOptions>(scene.cannula) : std::nullopt, dynamics);
+  const int tip = nearest_node(needle.mesh(), built.tip_point);
+  const double end_ms = scene.motion.end_time_ms();
+  log.line(fmt::format("run to {:.6g} ms with dt {:.4g} ms: about {:.0f} steps", end_ms, run.time_step_ms(), end_ms / run.time_step_ms()));
+
+  std::ofstream history(folder.path("history.csv"));
+  history << "time_ms,insertion_mm,tip_dx_mm,tip_dy_mm,tip_dz_mm,deflection_mm,base_reaction_x_N,base_reaction_y_N,"
+             "base_reaction_z_N,kinetic_mJ,strain_mJ,drive_work_mJ,cannula_work_mJ,energy_balance_error,"
+             "cannula_contact_nodes,cannula_max_penetration_mm,cannula_force_y_N\n";
+  double max_balance = 0, max_penetration = 0;
+  int max_contacts = 0;
+  auto record = [&] {
+    const Eigen::RowVector3d u = run.positions_mm().row(tip) - needle.mesh().X.row(tip);
+    const Eigen::Vector3d drive = run.drive_displacement_mm(), reaction = run.drive_reaction_N();
+    const NeedleEnergy& e = run.energy();
+    const CannulaContact& c = run.cannula_contact();
+    history << fmt::format("{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.6g},{},{:.6g},{:.6g}\n",
+                           run.time_ms(), drive.norm(), u.x(), u.y(), u.z(), u.y() - drive.y(), reaction.x(), reaction.y(),
+                           reaction.z(), e.kinetic_mJ, e.strain_mJ, e.drive_work_mJ, e.cannula_work_mJ, e.balance_error(),
+                           c.nodes_in_contact, c.max_penetration_mm, c.force_N.y());
+  };
+  std::vector<std::pair<double, std::string>> frames;
+  record();
+  if (scene.output.frames > 0) write_frame(folder, run, 0, frames);
+
+  ProgressBar progress(end_ms, o.quiet);
+  std::string status = "finished", reason;
+  double next_history = scene.output.history_interval_ms;
+  int next_frame = 1;
+  const auto solve_start = Clock::now();
+  try {
+    while (run.time_ms() < end_ms - 1e-12) {
+      run.step(end_ms);
+      const double balance = run.energy().balance_error();
+      if (std::abs(run.energy().drive_work_mJ) > 1e-6) max_balance = std::max(max_balance, balance);
+      max_penetration = std::max(max_penetration, run.cannula_contact().max_penetration_mm);
+      max_contacts = std::max(max_contacts, run.cannula_contact().nodes_in_contact);
+      if (run.time_ms() >= next_history - 1e-12 || run.time_ms() >= end_ms - 1e-12) {
+        record();
+        next_history += scene.output.history_interval_ms;
+      }
+      if (scene.output.frames > 0 && run.time_ms() >= next_frame * end_ms / scene.output.frames - 1e-12) {
+        write_frame(folder, run, next_frame++, frames);
+      }
+      progress.update(run.time_ms(), run.steps(), "ms");
+    }
+  } catch (const SolverError& e) {
+    status = "stopped";
+    reason = e.what();
+    record();
+  }
+  progress.finish();
+  const double solve_s = std::chrono::duration<double>(Clock::now() - solve_start).count();
+  history.close();
+  write_pvd(folder.path("needle.pvd"), frames);
+
+  const Eigen::RowVector3d u = run.positions_mm().row(tip) - needle.mesh().X.row(tip);
+  const double deflection = u.y() - run.drive_displacement_mm().y();
+  const json summary = {
+      {"status", status},
+      {"reason", reason},
+      {"needle", built.name},
+      {"deflection_mm", deflection},
+      {"tip_displacement_mm", {u.x(), u.y(), u.z()}},
+      {"insertion_mm", run.drive_displacement_mm().norm()},
+      {"time_ms", run.time_ms()},
+      {"steps", run.steps()},
+      {"time_step_ms", run.time_step_ms()},
+      {"unscaled_time_step_ms", needle.unscaled_time_step_ms()},
+      {"mass_g", needle.physical_mass_g()},
+      {"added_mass_percent", 100 * needle.added_mass_g() / needle.physical_mass_g()},
+      {"energy_balance_error", run.energy().balance_error()},
+      {"max_energy_balance_error", max_balance},
+      {"max_cannula_penetration_mm", max_penetration},
+      {"max_cannula_contact_nodes", max_contacts},
+      {"runtime_s", std::chrono::duration<double>(Clock::now() - start).count()},
+      {"solve_s", solve_s},
+      {"steps_per_s", run.steps() / std::max(solve_s, 1e-9)},
+      {"peak_memory_MiB", peak_memory_MiB()},
+      {"mesh", {{"order", needle.mesh().order}, {"elements", needle.num_elements()}, {"nodes", needle.num_nodes()},
+                {"straightened_tets", needle.mesh().straightened_tets}}},
+      {"threads", hardware_threads()},
+  };
+  {
+    std::ofstream out(folder.path("summary.json"));
+    out << summary.dump(2) << "\n";
+  }
+  log.line(fmt::format("{}{}: deflection {:.6g} mm after {} steps in {:.2f} s ({:.0f} steps/s), energy balance error {:.3g}",
+                       status, reason.empty() ? "" : " (" + reason + ")", deflection, run.steps(), solve_s,
+                       run.steps() / std::max(solve_s, 1e-9), run.energy().balance_error()));
+  folder.commit();
+  if (!o.quiet)
+    fmt::print("{} {}: deflection {:.6g} mm, {} steps, {:.1f} s -> {}\n", built.name, status, deflection, run.steps(), solve_s,
+               folder.final_path().string());
+  if (status != "finished") throw SolverError(reason + fmt::format(" (what was written so far is in {})", o.out_dir));
+}
+
+}  // namespace
+
+void add_simulate_command(CLI::App& app) {
+  auto o = std::make_shared<SimulateOptions>();
+  CLI::App* c = app.add_subcommand("simulate", "Run a scene file (JSON) and write a run folder (docs/scenes.md)");
+  c->add_option("scene", o->scene_file, "Scene file (JSON)")->required();
+  c->add_option("--out", o->out_dir, "Run folder to create")->required();
+  c->add_flag("--overwrite", o->overwrite, "Replace an existing run folder when the run ends");
+  c->add_flag("--quiet", o->quiet, "No progress bar or result line");
+  c->add_option("--threads", o->threads, "Worker threads (default: the scene's solver.threads; 0: all cores)");
+  c->callback([o] { run_simulation(*o); });
+}
+
+}  // namespace needle

@@ -1,0 +1,163 @@
+// Scene files and `needle simulate` as a user runs them: a small scene end to end, the run folder's
+// contents checked against the solver's own invariants, and bad scenes refused with file, line and
+// key, leaving no folder behind. Also `needle stiffness --json`.
+#include <catch2/catch.hpp>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "apps/scene.h"
+#include "cli_run.h"
+#include "geometry/input_error.h"
+
+namespace fs = std::filesystem;
+using needle_test::run;
+
+namespace {
+
+fs::path fresh_folder(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("needle_sim_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+void write(const fs::path& path, const std::string& text) { std::ofstream(path) << text; }
+
+std::string message_of(const std::string& text) {
+  try {
+    needle::parse_scene(text, "scene.json");
+  } catch (const needle::InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST_CASE("Scenes: paper defaults, units, and the effective scene reads back the same", "[apps][scene]") {
+  const needle::Scene paper = needle::parse_scene("{}", "scene.json");
+  CHECK(paper.needle.preset == "SB");
+  CHECK(paper.motion.travel_mm == 30.0);
+  CHECK(paper.motion.speed_mm_per_ms == 8.0);
+  CHECK(paper.motion.accel_time_ms == 0.75);
+  CHECK(paper.cannula.outer_diameter_mm == 1.27);
+  CHECK(paper.cannula.wall_mm == 0.05);
+  CHECK(paper.needle.material.youngs_modulus_MPa == 193000.0);
+  CHECK(paper.needle.mesh.order == 2);
+  CHECK(paper.needle.mesh.size_mm == 0.2);
+  CHECK(paper.tissue.spacing_mm == 0.4);
+  CHECK(paper.tissue.size_mm == Eigen::Vector3d(40, 8, 2));
+  // A value with its unit in the string is converted; the suffixed key takes a number.
+  const needle::Scene s = needle::parse_scene(
+      R"({"motion": {"travel": "2.5 cm", "speed": "8000 mm/s", "accel_time": "750 us"},
+          "needle": {"d_a": "-220 um", "material": {"youngs_modulus": "190 GPa", "density": "7900 kg/m3"}}})",
+      "scene.json");
+  CHECK(s.motion.travel_mm == Approx(25.0));
+  CHECK(s.motion.speed_mm_per_ms == Approx(8.0));
+  CHECK(s.motion.accel_time_ms == Approx(0.75));
+  CHECK(s.needle.d_a_mm == Approx(-0.22));
+  CHECK(s.needle.material.youngs_modulus_MPa == Approx(190000.0));
+  CHECK(s.needle.material.density_g_per_mm3 == Approx(7.9e-3));
+  const needle::Scene back = needle::parse_scene(needle::scene_to_json(s).dump(), "effective.json");
+  CHECK(needle::scene_to_json(back) == needle::scene_to_json(s));
+}
+
+TEST_CASE("Bad scenes name the file, the line and the key", "[apps][scene]") {
+  std::string m = message_of("{\n  \"motion\": {\n    \"travle_mm\": 30\n  }\n}");
+  CHECK(m.find("scene.json:3") != std::string::npos);
+  CHECK(m.find("motion.travle_mm") != std::string::npos);
+  CHECK(m.find("unknown key") != std::string::npos);
+  m = message_of("{\"needle\": {\n \"material\": {\n\n \"youngs_modulus_MPa\": -193000}}}");
+  CHECK(m.find("scene.json:4") != std::string::npos);
+  CHECK(m.find("needle.material.youngs_modulus_MPa must be positive") != std::string::npos);
+  m = message_of("{\"motion\": {\"travel\": 30}}");
+  CHECK(m.find("motion.travel") != std::string::npos);
+  CHECK(m.find("needs a unit") != std::string::npos);
+  m = message_of("{\"motion\": {\"travel\": \"30 MPa\"}}");
+  CHECK(m.find("is not a length") != std::string::npos);
+  m = message_of("{\"needle\": {\"mesh_file\": \"no_such.msh\"}}");
+  CHECK(m.find("needle.mesh_file") != std::string::npos);
+  CHECK(m.find("does not exist") != std::string::npos);
+  m = message_of("{\"motion\": {\"travel_mm\": 30,\n \"speed_m_per_s\": 8,, }}");
+  CHECK(m.find("scene.json:2") != std::string::npos);
+  CHECK(m.find("not valid JSON") != std::string::npos);
+  m = message_of("{\"needle\": {\"preset\": \"SB\", \"d_a_mm\": 0}}");
+  CHECK(m.find("give one of") != std::string::npos);
+  m = message_of("{\"cannula\": {\"wall_mm\": 0.7}}");
+  CHECK(m.find("no bore") != std::string::npos);
+}
+
+TEST_CASE("needle simulate: bad scenes exit non-zero and leave no run folder", "[apps][scene]") {
+  const fs::path dir = fresh_folder("bad");
+  const std::vector<std::string> scenes = {
+      R"({"motion": {"sped_m_per_s": 8}})", R"({"needle": {"material": {"youngs_modulus_MPa": -1}}})",
+      R"({"needle": {"mesh_file": "missing.msh"}})", R"({"motion": {"travel": 30}})", R"({"tissue": {"enabled": true}})"};
+  for (size_t i = 0; i < scenes.size(); ++i) {
+    write(dir / "scene.json", scenes[i]);
+    const auto r = run("simulate " + (dir / "scene.json").string() + " --out " + (dir / "run").string(), true);
+    INFO(scenes[i] << " -> " << r.out);
+    CHECK(r.exit_code == 2);
+    CHECK(std::count(r.out.begin(), r.out.end(), '\n') == 1);  // one clear line
+    CHECK(r.out.find("scene.json") != std::string::npos);
+    CHECK_FALSE(fs::exists(dir / "run"));
+    CHECK_FALSE(fs::exists(dir / ".run.partial"));
+  }
+}
+
+TEST_CASE("needle simulate: a rod pushed through the cannula writes a complete run folder", "[apps][scene][gmsh]") {
+  const fs::path dir = fresh_folder("rod");
+  write(dir / "scene.json", R"({
+    "needle": {"plain_rod": true, "length_mm": 20, "mesh": {"order": 1, "size_mm": 0.5}},
+    "motion": {"travel_mm": 4},
+    "solver": {"mass_scaling_dt_ms": 4e-5},
+    "output": {"frames": 3, "history_interval_ms": 0.05}
+  })");
+  const auto r = run("simulate " + (dir / "scene.json").string() + " --out " + (dir / "run").string() + " --quiet");
+  REQUIRE(r.exit_code == 0);
+  for (const char* f : {"scene.json", "history.csv", "summary.json", "needle.pvd", "run.log", "frames/needle_0003.vtu"})
+    CHECK(fs::is_regular_file(dir / "run" / f));
+  nlohmann::json summary;
+  std::ifstream(dir / "run" / "summary.json") >> summary;
+  CHECK(summary["status"] == "finished");
+  CHECK(summary["insertion_mm"].get<double>() == Approx(4.0));
+  CHECK(summary["energy_balance_error"].get<double>() < 0.005);
+  CHECK(std::abs(summary["deflection_mm"].get<double>()) < 1e-3);
+  CHECK(summary["tip_displacement_mm"][0].get<double>() == Approx(4.0).epsilon(1e-3));
+  // The history's last row matches the summary, and its drive work equals KE + strain energy.
+  std::ifstream csv(dir / "run" / "history.csv");
+  std::string header, line, last;
+  std::getline(csv, header);
+  int rows = 0;
+  while (std::getline(csv, line)) last = line, ++rows;
+  CHECK(rows > 10);
+  std::vector<double> v;
+  std::stringstream ss(last);
+  for (std::string cell; std::getline(ss, cell, ',');) v.push_back(std::stod(cell));
+  REQUIRE(v.size() == 17);
+  CHECK(v[1] == Approx(4.0));
+  CHECK(v[5] == Approx(summary["deflection_mm"].get<double>()).margin(1e-12));
+  CHECK(v[9] + v[10] == Approx(v[11] + v[12]).epsilon(0.005));
+  // The effective scene runs again to the same result, and an existing folder is refused.
+  const auto again = run("simulate " + (dir / "run" / "scene.json").string() + " --out " + (dir / "run").string() + " --quiet");
+  CHECK(again.exit_code == 2);
+  const auto replay = run("simulate " + (dir / "run" / "scene.json").string() + " --out " + (dir / "run2").string() + " --quiet");
+  REQUIRE(replay.exit_code == 0);
+  nlohmann::json summary2;
+  std::ifstream(dir / "run2" / "summary.json") >> summary2;
+  CHECK(summary2["deflection_mm"].get<double>() == Approx(summary["deflection_mm"].get<double>()).margin(1e-12));
+}
+
+TEST_CASE("needle stiffness --json reports compliance and frequencies with the beam reference", "[apps][needle][gmsh]") {
+  const auto r = run("stiffness --plain-rod --free-length-mm 30 --size-mm 0.3 --json");
+  REQUIRE(r.exit_code == 0);
+  const auto j = nlohmann::json::parse(r.out);
+  // 4 L^3 / (3 E pi r^4) for the plain rod, computed here.
+  const double reference = 30.0 * 30.0 * 30.0 / (3 * 193000.0 * M_PI * 0.0625 / 4);
+  CHECK(j["compliance_y_mm_per_N"].get<double>() == Approx(reference).epsilon(0.03));
+  CHECK(j["beam_theory"]["compliance_y_mm_per_N"].get<double>() == Approx(reference).epsilon(1e-6));
+  CHECK(j["frequency_y_hz"].get<double>() > 0);
+  CHECK(run("stiffness --plain-rod --free-length-mm -3").exit_code == 2);
+  CHECK(run("stiffness --preset XX").exit_code == 2);
+}
