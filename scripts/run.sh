@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The main job today: build the paper's four tips, write their reports (JSON), surfaces (STL, glb)
 # and pictures (PNG), their half-model T10 meshes (MSH, VTU), the tissue particles (VTP) and the
-# tissue card's uniaxial test (CSV, PNG, JSON) into out/, and print the speed-against-error benchmarks.
+# tissue card's uniaxial test (CSV, PNG, JSON), the needles' stiffness and a needle run folder into out/,
+# and print the speed-against-error benchmarks.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh
@@ -15,9 +16,14 @@ done
 ./build/apps/needle particles --preset SB --insert-mm 5 --out out/tissue_particles.vtp --json > out/tissue_particles.json
 ./build/apps/needle material-test --csv out/material_test.csv --png out/material_test.png
 ./build/apps/needle material-test --json > out/material_test.json
+./build/apps/needle stiffness --preset LMB --free-length-mm 30 --json > out/stiffness_LMB.json
+./build/apps/needle stiffness --preset SB --free-length-mm 30 --json > out/stiffness_SB.json
+./build/apps/needle simulate data/scenes/sb_quick.json --out out/sb_quick_run --overwrite
 ./build/bench/bench_tip 3 | tee out/bench_tip.txt
 ./build/bench/bench_mesh | tee out/bench_mesh.txt
 ./build/bench/bench_spg | tee out/bench_spg.txt
+./build/bench/bench_needle | tee out/bench_needle.txt
 echo "results in out/: <preset>.json (report), <preset>.stl, <preset>_half.glb, <preset>.png,"
 echo "  <preset>_half_t10.msh/.vtu + <preset>_mesh.json (T10 mesh and its report), tissue_particles.vtp/.json,"
-echo "  material_test.csv/.png/.json (the tissue card in uniaxial tension), bench_*.txt"
+echo "  material_test.csv/.png/.json (the tissue card in uniaxial tension), stiffness_<preset>.json (tip compliance"
+echo "  and bending frequencies), sb_quick_run/ (a run folder: SB pushed through the cannula), bench_*.txt"
