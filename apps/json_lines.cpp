@@ -41,12 +41,6 @@ class LineCountingIterator {
   int* line_;
 };
 
-std::string escape_pointer_token(const std::string& key) {
-  std::string out;
-  for (char c : key) out += c == '~' ? "~0" : c == '/' ? "~1" : std::string(1, c);
-  return out;
-}
-
 // Builds the document and records each key's line (the line the parser is on when the key ends).
 class LineTrackingBuilder : public nlohmann::json_sax<json> {
  public:
@@ -64,7 +58,7 @@ class LineTrackingBuilder : public nlohmann::json_sax<json> {
   bool end_array() override { return close(); }
   bool key(string_t& k) override {
     key_ = k;
-    doc_.lines[pointers_.back() + "/" + escape_pointer_token(k)] = line_;
+    doc_.lines[pointers_.back() + "/" + json_pointer_token(k)] = line_;
     return true;
   }
   bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception& e) override {
@@ -81,7 +75,7 @@ class LineTrackingBuilder : public nlohmann::json_sax<json> {
     json& top = *stack_.back();
     if (top.is_object()) {
       top[key_] = std::move(v);
-      return {&top[key_], pointers_.back() + "/" + escape_pointer_token(key_)};
+      return {&top[key_], pointers_.back() + "/" + json_pointer_token(key_)};
     }
     top.push_back(std::move(v));
     return {&top.back(), pointers_.back() + "/" + std::to_string(top.size() - 1)};
@@ -110,6 +104,12 @@ class LineTrackingBuilder : public nlohmann::json_sax<json> {
 };
 
 }  // namespace
+
+std::string json_pointer_token(const std::string& key) {
+  std::string out;
+  for (char c : key) out += c == '~' ? "~0" : c == '/' ? "~1" : std::string(1, c);
+  return out;
+}
 
 std::string JsonDocument::where(const std::string& pointer) const {
   const auto it = lines.find(pointer);

@@ -17,6 +17,9 @@ struct JsonDocument {
   std::string where(const std::string& pointer) const;
 };
 
+// A key as one token of a JSON pointer ("~" -> "~0", "/" -> "~1").
+std::string json_pointer_token(const std::string& key);
+
 // InputError naming the file and line on unreadable files or invalid JSON.
 JsonDocument parse_json_with_lines(const std::string& text, const std::string& source);
 JsonDocument read_json_with_lines(const std::string& path);

@@ -11,7 +11,11 @@ NeedleBuild build_needle(const TipGeometry& tip, bool half_model, const NeedleMe
   NeedleBuild b;
   b.tip = tip;
   const auto start = std::chrono::steady_clock::now();
-  b.mesh = mesh_needle(tip, half_model, mesh_options);
+  // gmsh's high-order optimiser is slow on coarse curved shafts (7.5 s on a 3 k-tet rod, still leaving
+  // folded tets); the mesher straightens the few tets it would fix instead (mesh_quality.h).
+  NeedleMeshOptions options = mesh_options;
+  options.high_order_optimize = false;
+  b.mesh = mesh_needle(tip, half_model, options);
   b.mesh_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   for (const FacetPlane& f : tip.facets)
     if (b.mesh.tag_index(f.name) >= 0) b.tip_facets.push_back(f.name);

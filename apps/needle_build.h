@@ -18,7 +18,7 @@ struct NeedleBuild {
   double mesh_seconds = 0;
 };
 
-// Meshes the tip (full, or the z >= 0 half).
+// Meshes the tip (full, or the z >= 0 half) for the solver, without gmsh's high-order optimiser.
 NeedleBuild build_needle(const TipGeometry& tip, bool half_model, const NeedleMeshOptions& mesh_options);
 
 }  // namespace needle

@@ -41,12 +41,6 @@ const char* dimension_name(Dimension d) {
   return "";
 }
 
-std::string pointer_token(const std::string& key) {
-  std::string out;
-  for (char c : key) out += c == '~' ? "~0" : c == '/' ? "~1" : std::string(1, c);
-  return out;
-}
-
 }  // namespace
 
 ValueCheck positive() {
@@ -84,7 +78,7 @@ SceneObject::SceneObject(const JsonDocument& doc, std::string pointer, std::stri
 }
 
 std::string SceneObject::where(const std::string& key) const {
-  return fmt::format("{}: {}{}", doc_.where(pointer_ + "/" + pointer_token(key)), name_.empty() ? "" : name_ + ".", key);
+  return fmt::format("{}: {}{}", doc_.where(pointer_ + "/" + json_pointer_token(key)), name_.empty() ? "" : name_ + ".", key);
 }
 
 bool SceneObject::has(const std::string& key) const { return object_.contains(key); }
@@ -174,7 +168,7 @@ Eigen::Vector3d SceneObject::vector3(const std::string& key, const Eigen::Vector
 
 SceneObject SceneObject::child(const std::string& key) {
   used_.insert(key);
-  return SceneObject(doc_, pointer_ + "/" + pointer_token(key), name_.empty() ? key : name_ + "." + key);
+  return SceneObject(doc_, pointer_ + "/" + json_pointer_token(key), name_.empty() ? key : name_ + "." + key);
 }
 
 void SceneObject::finish() const {

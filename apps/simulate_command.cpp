@@ -62,9 +62,7 @@ SceneNeedle build_scene_needle(const NeedleScene& n) {
     recipe.rod.length_mm = n.length_mm;
     tip = resolve_tip(recipe);
   }
-  NeedleMeshOptions mesh_options = n.mesh;
-  mesh_options.high_order_optimize = false;  // slow on coarse shafts; folded tets are straightened instead
-  const NeedleBuild build = build_needle(tip, n.half_model, mesh_options);
+  const NeedleBuild build = build_needle(tip, n.half_model, n.mesh);
   out.name = tip.name;
   out.mesh = build.mesh;
   out.tip_point = tip.tip_point;

@@ -79,9 +79,6 @@ void run_stiffness(StiffnessOptions& o) {
     recipe.rod.length_mm = o.free_length_mm;
     tip = resolve_tip(recipe);
   }
-  // gmsh's high-order optimiser is slow on coarse curved shafts; the few tets it would fix are
-  // straightened instead (mesh_quality.h).
-  o.mesh.high_order_optimize = false;
   const NeedleBuild build = build_needle(tip, false, o.mesh);
   auto t = Clock::now();
   const FeNeedle needle(build.mesh, o.material);

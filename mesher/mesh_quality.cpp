@@ -101,7 +101,10 @@ double scaled_jacobian(const TetMesh& mesh, int t, const std::vector<Eigen::Vect
                                                   node(mesh, mesh.T(t, 2)), node(mesh, mesh.T(t, 3)));
   if (!(straight > 0)) return -1.0;
   double worst = std::numeric_limits<double>::max();
-  for (const Eigen::Vector4d& s : samples) worst = std::min(worst, jacobian(mesh, t, s).determinant() / straight);
+  for (const Eigen::Vector4d& s : samples) {
+    worst = std::min(worst, jacobian(mesh, t, s).determinant() / straight);
+    if (mesh.order == 1) break;  // constant over a straight tet
+  }
   return worst;
 }
 
@@ -172,15 +175,9 @@ MeshQuality measure_quality(const TetMesh& mesh) {
         q.max_edge_mm = std::max(q.max_edge_mm, edge);
         sum_edge += edge;
       }
-    const double straight = 6.0 * volume;
-    bool inverted = volume <= 0;
-    for (const Eigen::Vector4d& s : samples) {
-      const double det = jacobian(mesh, t, s).determinant();
-      if (det <= 0) inverted = true;
-      q.min_scaled_jacobian = std::min(q.min_scaled_jacobian, straight > 0 ? det / straight : -1.0);
-      if (mesh.order == 1) break;
-    }
-    q.inverted_tets += inverted ? 1 : 0;
+    const double scaled = scaled_jacobian(mesh, t, samples);  // -1 for an inverted corner tet
+    q.min_scaled_jacobian = std::min(q.min_scaled_jacobian, scaled);
+    q.inverted_tets += (volume <= 0 || scaled <= 0) ? 1 : 0;
   }
   if (q.tets > 0) {
     q.mean_radius_ratio = sum_ratio / q.tets;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <map>
+#include <set>
 #include <stdexcept>
 
 #include "geometry/input_error.h"
@@ -141,6 +142,29 @@ TetMesh mirrored_union(const TetMesh& half, int axis) {
   full.boundary_faces.bottomRows(nf) = mirrored_cells(full.boundary_faces.topRows(nf));
   orient_tet_mesh(full);  // the mirror images are inside out until re-oriented
   return full;
+}
+
+std::vector<int> nodes_with_tag(const TetMesh& mesh, const std::string& tag) {
+  const int t = mesh.tag_index(tag);
+  NEEDLE_REQUIRE(t >= 0, "the mesh has no '" + tag + "' faces");
+  std::set<int> nodes;
+  for (int f = 0; f < mesh.num_boundary_faces(); ++f)
+    if (mesh.boundary_tag[f] == t)
+      for (int k = 0; k < mesh.nodes_per_face(); ++k) nodes.insert(mesh.boundary_faces(f, k));
+  return {nodes.begin(), nodes.end()};
+}
+
+std::vector<int> boundary_nodes(const TetMesh& mesh) {
+  std::set<int> nodes;
+  for (int f = 0; f < mesh.num_boundary_faces(); ++f)
+    for (int k = 0; k < mesh.nodes_per_face(); ++k) nodes.insert(mesh.boundary_faces(f, k));
+  return {nodes.begin(), nodes.end()};
+}
+
+int nearest_node(const TetMesh& mesh, const Eigen::Vector3d& p) {
+  Eigen::Index best = 0;
+  (mesh.X.rowwise() - p.transpose()).rowwise().squaredNorm().minCoeff(&best);
+  return static_cast<int>(best);
 }
 
 }  // namespace needle

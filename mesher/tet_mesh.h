@@ -51,6 +51,12 @@ void orient_tet_mesh(TetMesh& mesh);
 // `symmetry` faces are dropped. InputError if a node lies on the wrong side.
 TetMesh mirrored_union(const TetMesh& half, int axis);
 
+// Nodes on the boundary faces with this tag (sorted, unique); InputError if the tag is absent.
+std::vector<int> nodes_with_tag(const TetMesh& mesh, const std::string& tag);
+// Nodes on any boundary face (sorted, unique).
+std::vector<int> boundary_nodes(const TetMesh& mesh);
+int nearest_node(const TetMesh& mesh, const Eigen::Vector3d& point_mm);
+
 // Drops nodes no tet uses and renumbers the rest (gmsh keeps geometry points that may be unused).
 void drop_unused_nodes(TetMesh& mesh);
 

@@ -13,15 +13,19 @@ namespace {
 
 using Mat3 = Eigen::Matrix3d;
 
-// Deformation gradient at one quadrature point from nodal displacements.
-Mat3 deformation_gradient(const double* dN, const Eigen::MatrixX3d& x, const Eigen::MatrixX3d& X, const int* nodes,
-                          int npe) {
+using ElementDisplacements = Eigen::Matrix<double, 10, 3>;  // rows beyond npe unused (T4)
+
+// The element's nodal displacements, gathered once for all its quadrature points.
+ElementDisplacements element_displacements(const TetMesh& mesh, int e, const Eigen::MatrixX3d& x, int npe) {
+  ElementDisplacements u;
+  for (int a = 0; a < npe; ++a) u.row(a) = x.row(mesh.T(e, a)) - mesh.X.row(mesh.T(e, a));
+  return u;
+}
+
+// Deformation gradient at one quadrature point: F = I + sum_a u_a (x) dN_a/dX.
+Mat3 deformation_gradient(const double* dN, const ElementDisplacements& u, int npe) {
   Mat3 F = Mat3::Identity();
-  for (int a = 0; a < npe; ++a) {
-    const Eigen::RowVector3d u = x.row(nodes[a]) - X.row(nodes[a]);
-    const Eigen::Map<const Eigen::RowVector3d> g(dN + 3 * a);
-    F += u.transpose() * g;
-  }
+  for (int a = 0; a < npe; ++a) F += u.row(a).transpose() * Eigen::Map<const Eigen::RowVector3d>(dN + 3 * a);
   return F;
 }
 
@@ -128,14 +132,13 @@ double FeNeedle::internal_forces(const Eigen::MatrixX3d& x, Eigen::MatrixX3d& fo
   const int ne = num_elements();
   parallel_for(ne, [&](std::int64_t begin, std::int64_t end) {
     for (std::int64_t e = begin; e < end; ++e) {
-      int node_ids[10];
-      for (int a = 0; a < npe_; ++a) node_ids[a] = mesh_.T(static_cast<int>(e), a);
+      const ElementDisplacements u = element_displacements(mesh_, static_cast<int>(e), x, npe_);
       double* fe = &element_forces_[static_cast<size_t>(e) * npe_ * 3];
       std::fill(fe, fe + npe_ * 3, 0.0);
       double energy = 0;
       for (int q = 0; q < qp_; ++q) {
         const double* dN = gradients(static_cast<int>(e), q);
-        const Mat3 F = deformation_gradient(dN, x, mesh_.X, node_ids, npe_);
+        const Mat3 F = deformation_gradient(dN, u, npe_);
         const Mat3 E = 0.5 * (F.transpose() * F - Mat3::Identity());
         const double trE = E.trace();
         const Mat3 S = lambda * trE * Mat3::Identity() + 2.0 * mu * E;
@@ -192,12 +195,11 @@ ElementStresses FeNeedle::element_stresses(const Eigen::MatrixX3d& x) const {
   out.cauchy_MPa.resize(num_elements(), 6);
   parallel_for(num_elements(), [&](std::int64_t begin, std::int64_t end) {
     for (std::int64_t e = begin; e < end; ++e) {
-      int node_ids[10];
-      for (int a = 0; a < npe_; ++a) node_ids[a] = mesh_.T(static_cast<int>(e), a);
+      const ElementDisplacements u = element_displacements(mesh_, static_cast<int>(e), x, npe_);
       Mat3 mean = Mat3::Zero();
       double vm = 0;
       for (int q = 0; q < qp_; ++q) {
-        const Mat3 F = deformation_gradient(gradients(static_cast<int>(e), q), x, mesh_.X, node_ids, npe_);
+        const Mat3 F = deformation_gradient(gradients(static_cast<int>(e), q), u, npe_);
         const Mat3 E = 0.5 * (F.transpose() * F - Mat3::Identity());
         const Mat3 S = lambda * E.trace() * Mat3::Identity() + 2.0 * mu * E;
         const Mat3 sigma = F * S * F.transpose() / F.determinant();

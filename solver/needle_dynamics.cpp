@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
-#include <set>
 
 #include "geometry/input_error.h"
 #include "solver/solver_error.h"
@@ -37,14 +36,10 @@ NeedleDynamics::NeedleDynamics(const FeNeedle& needle, NeedleSupports supports, 
   mark(supports_.driven, 7, "driven");
   for (int i = 0; i < n; ++i)
     if (mask_[static_cast<size_t>(i)]) constrained_.push_back(i);
+  v_before_.resize(static_cast<Eigen::Index>(constrained_.size()), 3);
   dt_ms_ = options_.courant * needle.stable_time_step_ms();
   mass_ = needle.nodal_mass_g();
-  if (cannula && cannula->enabled) {
-    std::set<int> surface;
-    for (int f = 0; f < needle.mesh().num_boundary_faces(); ++f)
-      for (int k = 0; k < needle.mesh().nodes_per_face(); ++k) surface.insert(needle.mesh().boundary_faces(f, k));
-    cannula_.emplace(*cannula, std::vector<int>(surface.begin(), surface.end()), mass_, dt_ms_);
-  }
+  if (cannula && cannula->enabled) cannula_.emplace(*cannula, boundary_nodes(needle.mesh()), mass_, dt_ms_);
   x_ = needle.mesh().X;
   v_ = Eigen::MatrixX3d::Zero(n, 3);
   compute_forces(v_);
@@ -61,9 +56,10 @@ void NeedleDynamics::set_initial_state(const Eigen::MatrixX3d& x, const Eigen::M
   apply_supports(v_, 0.0);
   compute_forces(v_);
   a_ = force_.array().colwise() / mass_.array();
+  const double strain = energy_.strain_mJ;  // from compute_forces
   energy_ = NeedleEnergy{};
+  energy_.strain_mJ = strain;
   energy_.kinetic_mJ = 0.5 * mass_.dot(v_.rowwise().squaredNorm());
-  energy_.strain_mJ = needle_.internal_forces(x_, old_force_);
   energy_.initial_mJ = energy_.kinetic_mJ + energy_.strain_mJ;
 }
 
@@ -76,7 +72,7 @@ void NeedleDynamics::apply_supports(Eigen::MatrixX3d& v, double t) const {
 
 void NeedleDynamics::compute_forces(const Eigen::MatrixX3d& velocity) {
   energy_.strain_mJ = needle_.internal_forces(x_, force_);
-  cannula_force_ = Eigen::MatrixX3d::Zero(force_.rows(), 3);
+  cannula_force_.setZero(force_.rows(), 3);  // no allocation once sized
   if (cannula_) contact_ = cannula_->add_forces(x_, velocity, cannula_force_);
   force_ += cannula_force_;
   if (!force_.allFinite() || !std::isfinite(energy_.strain_mJ))
@@ -89,7 +85,7 @@ void NeedleDynamics::compute_forces(const Eigen::MatrixX3d& velocity) {
 void NeedleDynamics::step(double end_time_ms) {
   const double dt = std::min(dt_ms_, end_time_ms - time_ms_);
   NEEDLE_REQUIRE(dt > 0, "the needle run has reached its end time");
-  v_before_ = v_;
+  for (size_t k = 0; k < constrained_.size(); ++k) v_before_.row(static_cast<Eigen::Index>(k)) = v_.row(constrained_[k]);
   // Half kick and drift; driven nodes move exactly by the profile's displacement over the step.
   v_ += 0.5 * dt * a_;
   apply_supports(v_, time_ms_ + 0.5 * dt);
@@ -99,8 +95,8 @@ void NeedleDynamics::step(double end_time_ms) {
   x_ += dt * v_half_;
   time_ms_ += dt;
 
-  old_force_ = force_;
-  old_cannula_force_ = cannula_force_;
+  old_force_.swap(force_);
+  old_cannula_force_.swap(cannula_force_);
   compute_forces(v_half_);  // the cannula's friction reads the mid-step velocity
   a_ = force_.array().colwise() / mass_.array();
   v_ = v_half_ + 0.5 * dt * a_;
@@ -111,13 +107,16 @@ void NeedleDynamics::step(double end_time_ms) {
   energy_.cannula_work_mJ += 0.5 * dt * ((old_cannula_force_ + cannula_force_).cwiseProduct(v_half_)).sum();
   double drive_work = 0;
   drive_reaction_.setZero();
-  for (int i : constrained_)
+  for (size_t c = 0; c < constrained_.size(); ++c) {
+    const int i = constrained_[c];
     for (int k = 0; k < 3; ++k) {
       if (!(mask_[static_cast<size_t>(i)] & (1 << k))) continue;
-      const double impulse = mass_[i] * (v_(i, k) - v_before_(i, k)) - 0.5 * (old_force_(i, k) + force_(i, k)) * dt;
+      const double impulse =
+          mass_[i] * (v_(i, k) - v_before_(static_cast<Eigen::Index>(c), k)) - 0.5 * (old_force_(i, k) + force_(i, k)) * dt;
       drive_work += impulse * v_half_(i, k);
       drive_reaction_[k] += impulse / dt;
     }
+  }
   energy_.drive_work_mJ += drive_work;
   energy_.kinetic_mJ = 0.5 * mass_.dot(v_.rowwise().squaredNorm());
   ++steps_;

@@ -74,7 +74,8 @@ class NeedleDynamics {
   double dt_ms_ = 0, time_ms_ = 0;
   long steps_ = 0;
   Eigen::MatrixX3d x_, v_, a_, force_, old_force_, cannula_force_, old_cannula_force_;
-  Eigen::MatrixX3d v_before_, v_half_;  // step scratch
+  Eigen::MatrixX3d v_before_;  // step scratch: velocities of the constrained nodes before the step
+  Eigen::MatrixX3d v_half_;
   Eigen::VectorXd mass_;
   std::vector<std::uint8_t> mask_;  // per node: bit k = component k prescribed
   std::vector<int> constrained_;

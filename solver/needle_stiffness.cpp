@@ -30,22 +30,6 @@ Eigen::VectorXd facet_load_weights(const TetMesh& mesh, const std::vector<std::s
   return w / w.sum();
 }
 
-std::vector<int> nodes_with_tag(const TetMesh& mesh, const std::string& tag) {
-  const int t = mesh.tag_index(tag);
-  NEEDLE_REQUIRE(t >= 0, fmt::format("the mesh has no '{}' faces", tag));
-  std::set<int> nodes;
-  for (int f = 0; f < mesh.num_boundary_faces(); ++f)
-    if (mesh.boundary_tag[f] == t)
-      for (int k = 0; k < mesh.nodes_per_face(); ++k) nodes.insert(mesh.boundary_faces(f, k));
-  return {nodes.begin(), nodes.end()};
-}
-
-int nearest_node(const TetMesh& mesh, const Eigen::Vector3d& p) {
-  Eigen::Index best = 0;
-  (mesh.X.rowwise() - p.transpose()).rowwise().squaredNorm().minCoeff(&best);
-  return static_cast<int>(best);
-}
-
 StiffnessResult analyse_stiffness(const FeNeedle& needle, const Eigen::Vector3d& tip_point,
                                   const std::vector<std::string>& load_tags, const std::string& clamp_tag, int modes) {
   const TetMesh& mesh = needle.mesh();

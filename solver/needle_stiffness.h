@@ -15,11 +15,6 @@ namespace needle {
 // tags. InputError if no face carries any of the tags.
 Eigen::VectorXd facet_load_weights(const TetMesh& mesh, const std::vector<std::string>& tags);
 
-// Nodes on the boundary faces with this tag (sorted, unique); InputError if the tag is absent.
-std::vector<int> nodes_with_tag(const TetMesh& mesh, const std::string& tag);
-
-int nearest_node(const TetMesh& mesh, const Eigen::Vector3d& point_mm);
-
 struct StiffnessResult {
   double compliance_y_mm_per_N = 0, compliance_z_mm_per_N = 0;
   double frequency_y_hz = 0, frequency_z_hz = 0;
