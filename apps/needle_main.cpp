@@ -5,6 +5,7 @@
 
 #include "apps/material_test_command.h"
 #include "apps/mesh_command.h"
+#include "apps/run_command.h"
 #include "apps/simulate_command.h"
 #include "apps/stiffness_command.h"
 #include "apps/tip_command.h"
@@ -20,6 +21,7 @@ int main(int argc, char** argv) {
   needle::add_material_test_command(app);
   needle::add_stiffness_command(app);
   needle::add_simulate_command(app);
+  needle::add_run_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdio>
 #include <fmt/format.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include "geometry/input_error.h"
@@ -78,6 +79,19 @@ void ProgressBar::update(double value, long step, const std::string& unit) {
 
 void ProgressBar::finish() {
   if (!quiet_ && tty_) fmt::print(stderr, "\n");
+}
+
+void write_pvd(const std::filesystem::path& path, const std::vector<std::pair<double, std::string>>& frames) {
+  std::ofstream out(path);
+  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n";
+  for (const auto& [time, file] : frames) out << fmt::format("    <DataSet timestep=\"{:.9g}\" file=\"{}\"/>\n", time, file);
+  out << "  </Collection>\n</VTKFile>\n";
+}
+
+double peak_memory_MiB() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;
 }
 
 }  // namespace needle

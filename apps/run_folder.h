@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace needle {
 
@@ -51,5 +53,11 @@ class ProgressBar {
   int last_decile_ = -1;
   bool quiet_, tty_;
 };
+
+// A ParaView collection (.pvd) of (time, file) frames.
+void write_pvd(const std::filesystem::path& path, const std::vector<std::pair<double, std::string>>& frames);
+
+// The process's peak resident memory (MiB).
+double peak_memory_MiB();
 
 }  // namespace needle

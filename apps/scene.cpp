@@ -54,6 +54,7 @@ void read_needle(SceneObject o, NeedleScene& n, const std::string& scene_folder)
     n.material.density_g_per_mm3 = m.quantity("density", Dimension::density, n.material.density_g_per_mm3, positive());
     m.finish();
   }
+  n.rigid = o.boolean("rigid", n.rigid);
   o.finish();
 }
 
@@ -88,11 +89,42 @@ void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc) {
   t.enabled = o.boolean("enabled", t.enabled);
   t.size_mm = o.vector3("size_mm", t.size_mm);
   NEEDLE_REQUIRE((t.size_mm.array() > 0).all(), fmt::format("{} must be three positive lengths", o.where("size_mm")));
+  t.entry_x_mm = o.quantity("entry_x", Dimension::length, t.entry_x_mm, any_finite());
   t.spacing_mm = o.quantity("spacing", Dimension::length, t.spacing_mm, positive());
   t.dilation = o.number("dilation", t.dilation, within(1.0, 4.0));
+  t.spg.dilation = t.dilation;
   t.friction = o.number("friction", t.friction, non_negative());
+  t.contact.friction = t.friction;
   if (o.has("material")) t.material = material_from_json(o.raw("material"), doc.where("/tissue/material"), t.material);
   t.material.validate();
+  if (o.has("spg")) {
+    SceneObject g = o.child("spg");
+    const auto name = [&](const std::string& key, const std::string& fallback, auto parse) {
+      const std::string value = g.text(key, fallback);
+      try {
+        return parse(value);
+      } catch (const InputError& e) {
+        throw InputError(fmt::format("{}: {}", g.where(key), e.what()));
+      }
+    };
+    t.spg.kernel_update = name("kernel_update", kernel_update_name(t.spg.kernel_update), kernel_update_from_name);
+    t.spg.kernel_update_interval_steps = g.integer("kernel_update_interval_steps", t.spg.kernel_update_interval_steps, 1, 1000000);
+    t.spg.stabilization = name("stabilization", stabilization_name(t.spg.stabilization), stabilization_from_name);
+    t.spg.stabilization_coefficient = g.number("stabilization_coefficient", t.spg.stabilization_coefficient, within(0.0, 10.0));
+    t.spg.smoothing_interval_steps = g.integer("smoothing_interval_steps", t.spg.smoothing_interval_steps, 1, 1000000);
+    t.spg.bond_failure.enabled = g.boolean("bond_failure", t.spg.bond_failure.enabled);
+    t.spg.bond_failure.plastic_strain = g.number("failure_plastic_strain", t.spg.bond_failure.plastic_strain, positive());
+    t.spg.bond_failure.stretch_ratio = g.number("failure_stretch_ratio", t.spg.bond_failure.stretch_ratio, non_negative());
+    t.spg.cfl = g.number("cfl", t.spg.cfl, within(1e-3, 1.0));
+    g.finish();
+  }
+  if (o.has("contact")) {
+    SceneObject c = o.child("contact");
+    t.contact.stiffness_factor = c.number("stiffness_factor", t.contact.stiffness_factor, within(1e-3, 1e4));
+    t.contact.skin_mm = c.quantity("skin", Dimension::length, t.contact.skin_mm, non_negative());
+    t.contact.voxel_mm = c.quantity("voxel", Dimension::length, t.contact.voxel_mm, within(1e-3, 0.2));
+    c.finish();
+  }
   o.finish();
 }
 
@@ -102,6 +134,12 @@ void read_solver(SceneObject o, SolverScene& s) {
   s.max_energy_error = o.number("max_energy_error", s.max_energy_error, positive());
   s.max_penetration_mm = o.quantity("max_penetration", Dimension::length, s.max_penetration_mm, positive());
   s.threads = o.integer("threads", s.threads, 0, 1024);
+  CouplingOptions& c = s.coupling;
+  c.subcycling = o.boolean("subcycling", c.subcycling);
+  c.max_step_ms = o.quantity("max_coupling_step", Dimension::time, c.max_step_ms, non_negative());
+  c.contact_courant = o.number("contact_courant", c.contact_courant, within(1e-3, 1.0));
+  c.max_energy_error = s.max_energy_error;
+  c.max_depth_mm = o.quantity("max_contact_depth", Dimension::length, c.max_depth_mm, positive());
   o.finish();
 }
 
@@ -150,6 +188,21 @@ json scene_to_json(const Scene& s) {
                     {"edge_size_mm", n.mesh.edge_size_mm}, {"shaft_size_mm", n.mesh.shaft_size_mm}, {"grading_mm", n.mesh.grading_mm}};
   needle["material"] = {{"youngs_modulus_MPa", n.material.youngs_modulus_MPa}, {"poisson_ratio", n.material.poisson_ratio},
                         {"density_g_per_cm3", n.material.density_g_per_mm3 * 1e3}};
+  needle["rigid"] = n.rigid;
+  const TissueScene& t = s.tissue;
+  const json tissue = {
+      {"enabled", t.enabled}, {"size_mm", vector_json(t.size_mm)}, {"entry_x_mm", t.entry_x_mm}, {"spacing_mm", t.spacing_mm},
+      {"dilation", t.dilation}, {"friction", t.friction}, {"material", material_to_json(t.material)},
+      {"spg", {{"kernel_update", kernel_update_name(t.spg.kernel_update)},
+               {"kernel_update_interval_steps", t.spg.kernel_update_interval_steps},
+               {"stabilization", stabilization_name(t.spg.stabilization)},
+               {"stabilization_coefficient", t.spg.stabilization_coefficient},
+               {"smoothing_interval_steps", t.spg.smoothing_interval_steps},
+               {"bond_failure", t.spg.bond_failure.enabled},
+               {"failure_plastic_strain", t.spg.bond_failure.plastic_strain},
+               {"failure_stretch_ratio", t.spg.bond_failure.stretch_ratio},
+               {"cfl", t.spg.cfl}}},
+      {"contact", {{"stiffness_factor", t.contact.stiffness_factor}, {"skin_mm", t.contact.skin_mm}, {"voxel_mm", t.contact.voxel_mm}}}};
   const CannulaOptions& c = s.cannula;
   return {
       {"needle", needle},
@@ -158,11 +211,12 @@ json scene_to_json(const Scene& s) {
       {"cannula", {{"enabled", c.enabled}, {"outer_diameter_mm", c.outer_diameter_mm}, {"wall_mm", c.wall_mm},
                    {"front_x_mm", c.front_x_mm}, {"length_mm", c.length_mm}, {"friction", c.friction},
                    {"penalty_scale", c.penalty_scale}}},
-      {"tissue", {{"enabled", s.tissue.enabled}, {"size_mm", vector_json(s.tissue.size_mm)}, {"spacing_mm", s.tissue.spacing_mm},
-                  {"dilation", s.tissue.dilation}, {"friction", s.tissue.friction}, {"material", material_to_json(s.tissue.material)}}},
+      {"tissue", tissue},
       {"solver", {{"courant", s.solver.courant}, {"mass_scaling_dt_ms", s.solver.mass_scaling_dt_ms},
                   {"max_energy_error", s.solver.max_energy_error}, {"max_penetration_mm", s.solver.max_penetration_mm},
-                  {"threads", s.solver.threads}}},
+                  {"threads", s.solver.threads}, {"subcycling", s.solver.coupling.subcycling},
+                  {"max_coupling_step_ms", s.solver.coupling.max_step_ms}, {"contact_courant", s.solver.coupling.contact_courant},
+                  {"max_contact_depth_mm", s.solver.coupling.max_depth_mm}}},
       {"output", {{"history_interval_ms", s.output.history_interval_ms}, {"frames", s.output.frames}}},
   };
 }

@@ -10,6 +10,8 @@
 
 #include "mesher/needle_mesher.h"
 #include "solver/insertion_profile.h"
+#include "solver/lspg_insertion.h"
+#include "solver/spg_options.h"
 #include "solver/needle_material.h"
 #include "solver/rigid_cannula.h"
 #include "solver/tissue_material.h"
@@ -25,13 +27,17 @@ struct NeedleScene {
   bool half_model = true;   // z >= 0 half with a symmetry plane (paper)
   NeedleMeshOptions mesh;   // T10, 0.2 mm (paper)
   NeedleMaterial material;  // AISI 304
+  bool rigid = false;       // a rigid needle (no deflection; tissue studies only)
 };
 
-struct TissueScene {  // read and checked; the coupled run comes with the L-SPG solver
-  bool enabled = false;
-  Eigen::Vector3d size_mm{40.0, 8.0, 2.0};
+struct TissueScene {
+  bool enabled = false;                     // false: the needle and cannula alone (needle simulate)
+  Eigen::Vector3d size_mm{40.0, 8.0, 2.0};  // x from entry_x, y centred on the axis, z from the symmetry plane
+  double entry_x_mm = 0.0;                  // the block's entry face (tip point A starts at x = 0)
   double spacing_mm = 0.4, dilation = 1.8, friction = 0.18;
   TissueMaterial material;
+  SpgOptions spg;                           // kernel, stabilization, bond failure, cfl (docs/solver.md)
+  ContactOptions contact;                   // friction copied from `friction`
 };
 
 struct SolverScene {
@@ -40,6 +46,7 @@ struct SolverScene {
   double max_energy_error = 0.05;
   double max_penetration_mm = 0.05;
   int threads = 0;
+  CouplingOptions coupling;  // subcycling, step caps, the insertion's stop criteria
 };
 
 struct OutputScene {

@@ -7,15 +7,12 @@
 #include <fmt/format.h>
 #include <fstream>
 #include <iostream>
-#include <sys/resource.h>
 
-#include "apps/needle_build.h"
-#include "apps/recipe_json.h"
+#include "apps/insertion_run.h"
 #include "apps/run_folder.h"
 #include "apps/scene.h"
-#include "geometry/grinding_recipe.h"
+#include "apps/scene_needle.h"
 #include "geometry/input_error.h"
-#include "mesher/msh_file.h"
 #include "mesher/vtk_files.h"
 #include "solver/needle_dynamics.h"
 #include "solver/needle_stiffness.h"
@@ -34,48 +31,6 @@ struct SimulateOptions {
   int threads = -1;
 };
 
-// The mesh, its tip point A and its name, from the scene's needle section.
-struct SceneNeedle {
-  std::string name;
-  TetMesh mesh;
-  Eigen::Vector3d tip_point = Eigen::Vector3d::Zero();
-  double mesh_seconds = 0;
-};
-
-SceneNeedle build_scene_needle(const NeedleScene& n) {
-  SceneNeedle out;
-  if (!n.mesh_file.empty()) {
-    out.name = n.mesh_file;
-    out.mesh = read_msh(n.mesh_file);
-    Eigen::Index distal = 0;
-    out.mesh.X.col(0).maxCoeff(&distal);  // A: the most distal node
-    out.tip_point = out.mesh.X.row(distal).transpose();
-    return out;
-  }
-  TipGeometry tip;
-  if (n.plain_rod) {
-    tip = plain_rod_tip(1.0, n.length_mm);
-  } else {
-    GrindingRecipe recipe = !n.preset.empty() ? preset_recipe(n.preset)
-                            : !n.recipe_file.empty() ? read_recipe_file(n.recipe_file)
-                                                     : multi_bevel_recipe(n.d_a_mm);
-    recipe.rod.length_mm = n.length_mm;
-    tip = resolve_tip(recipe);
-  }
-  const NeedleBuild build = build_needle(tip, n.half_model, n.mesh);
-  out.name = tip.name;
-  out.mesh = build.mesh;
-  out.tip_point = tip.tip_point;
-  out.mesh_seconds = build.mesh_seconds;
-  return out;
-}
-
-double peak_memory_MiB() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return static_cast<double>(usage.ru_maxrss) / 1024.0;
-}
-
 void write_frame(const RunFolder& folder, const NeedleDynamics& run, int index, std::vector<std::pair<double, std::string>>& frames) {
   TetMesh deformed = run.needle().mesh();
   deformed.X = run.positions_mm();
@@ -87,19 +42,18 @@ void write_frame(const RunFolder& folder, const NeedleDynamics& run, int index, 
   frames.emplace_back(run.time_ms(), name);
 }
 
-void write_pvd(const std::filesystem::path& path, const std::vector<std::pair<double, std::string>>& frames) {
-  std::ofstream out(path);
-  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n";
-  for (const auto& [time, file] : frames) out << fmt::format("    <DataSet timestep=\"{:.9g}\" file=\"{}\"/>\n", time, file);
-  out << "  </Collection>\n</VTKFile>\n";
-}
-
 void run_simulation(const SimulateOptions& o) {
   // Everything that can be wrong with the input is found before the run folder exists.
   const Scene scene = read_scene(o.scene_file);
-  NEEDLE_REQUIRE(!scene.tissue.enabled,
-                 fmt::format("{}: tissue.enabled: the coupled needle-tissue (L-SPG) run is not in this version; "
-                             "set it to false to run the needle and cannula alone", scene.source));
+  if (scene.tissue.enabled) {
+    RunOptions run;
+    run.out_dir = o.out_dir;
+    run.overwrite = o.overwrite;
+    run.quiet = o.quiet;
+    run.threads = o.threads;
+    run_insertion(scene, run);
+    return;
+  }
   const ThreadLimit threads(o.threads >= 0 ? o.threads : scene.solver.threads);
   RunFolder folder(o.out_dir, o.overwrite);
   std::filesystem::create_directories(folder.path("frames"));

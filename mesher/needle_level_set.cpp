@@ -15,7 +15,7 @@ namespace needle {
 
 struct NeedleLevelSet::Impl {
   openvdb::FloatGrid::Ptr grid;
-  double voxel = 0, band = 0, seconds = 0;
+  double voxel = 0, band = 0, interior_band = 0, seconds = 0;
 
   double sample(const Eigen::Vector3d& p) const {
     openvdb::FloatGrid::ConstAccessor accessor = grid->getConstAccessor();
@@ -29,6 +29,9 @@ NeedleLevelSet::NeedleLevelSet(const TriSurface& surface, const LevelSetOptions&
                  fmt::format("level-set voxel size must be in [0.0001, 1] mm (got {})", options.voxel_mm));
   NEEDLE_REQUIRE(options.half_width_voxels >= 1 && options.half_width_voxels <= 64,
                  "level-set half width must be 1 to 64 voxels");
+  NEEDLE_REQUIRE(options.interior_width_voxels >= 0 && options.interior_width_voxels <= 1000,
+                 "level-set interior width must be 0 to 1000 voxels");
+  const int interior_voxels = options.interior_width_voxels > 0 ? options.interior_width_voxels : options.half_width_voxels;
   const TopologyCheck topology = check_topology(surface);
   NEEDLE_REQUIRE(topology.closed_manifold(), "no level set of an open surface: " + topology.describe());
   const Eigen::Vector3d extent = surface.V.colwise().maxCoeff() - surface.V.colwise().minCoeff();
@@ -47,10 +50,12 @@ NeedleLevelSet::NeedleLevelSet(const TriSurface& surface, const LevelSetOptions&
     triangles[static_cast<size_t>(f)] = openvdb::Vec3I(static_cast<unsigned>(surface.F(f, 0)), static_cast<unsigned>(surface.F(f, 1)),
                                                        static_cast<unsigned>(surface.F(f, 2)));
   const auto transform = openvdb::math::Transform::createLinearTransform(options.voxel_mm);
-  impl_->grid = openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(*transform, points, triangles,
-                                                                   static_cast<float>(options.half_width_voxels));
+  const std::vector<openvdb::Vec4I> no_quads;
+  impl_->grid = openvdb::tools::meshToSignedDistanceField<openvdb::FloatGrid>(
+      *transform, points, triangles, no_quads, static_cast<float>(options.half_width_voxels), static_cast<float>(interior_voxels));
   impl_->voxel = options.voxel_mm;
   impl_->band = options.voxel_mm * options.half_width_voxels;
+  impl_->interior_band = options.voxel_mm * interior_voxels;
   impl_->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
@@ -71,6 +76,7 @@ Eigen::Vector3d NeedleLevelSet::gradient(const Eigen::Vector3d& p) const {
 }
 
 double NeedleLevelSet::band_mm() const { return impl_->band; }
+double NeedleLevelSet::interior_band_mm() const { return impl_->interior_band; }
 double NeedleLevelSet::voxel_mm() const { return impl_->voxel; }
 long NeedleLevelSet::active_voxels() const { return static_cast<long>(impl_->grid->activeVoxelCount()); }
 long NeedleLevelSet::memory_bytes() const { return static_cast<long>(impl_->grid->memUsage()); }
@@ -86,7 +92,7 @@ PenetrationReport find_penetrations(const NeedleLevelSet& needle, const Eigen::M
     if (d < 0) {
       report.inside.push_back(static_cast<int>(i));
       report.max_depth_mm = std::max(report.max_depth_mm, -d);
-      if (-d >= 0.999 * needle.band_mm()) report.depth_saturated = true;
+      if (-d >= 0.999 * needle.interior_band_mm()) report.depth_saturated = true;
     }
   }
   return report;

@@ -17,7 +17,9 @@ namespace needle {
 
 struct LevelSetOptions {
   double voxel_mm = 0.02;      // grid spacing; error scales with it, cost with its inverse square
-  int half_width_voxels = 3;   // narrow band half width
+  int half_width_voxels = 3;   // narrow band half width (outside, and inside unless interior_width_voxels is set)
+  int interior_width_voxels = 0;  // band depth inside the surface; 0: half_width_voxels. Contact needs the
+                                  // whole interior (depth >= the needle's radius) to push deep points out.
 };
 
 class NeedleLevelSet {
@@ -28,13 +30,14 @@ class NeedleLevelSet {
   NeedleLevelSet(NeedleLevelSet&&) noexcept;
   NeedleLevelSet& operator=(NeedleLevelSet&&) noexcept;
 
-  // Signed distance, negative inside, clamped to +-band_mm() outside the band.
+  // Signed distance, negative inside, clamped to band_mm() outside and -interior_band_mm() inside.
   double signed_distance_mm(const Eigen::Vector3d& p) const;
   // Gradient of the distance (about the outward unit normal in the band, zero outside it).
   Eigen::Vector3d gradient(const Eigen::Vector3d& p) const;
   bool inside(const Eigen::Vector3d& p) const { return signed_distance_mm(p) < 0; }
 
   double band_mm() const;
+  double interior_band_mm() const;
   double voxel_mm() const;
   long active_voxels() const;
   long memory_bytes() const;

@@ -11,9 +11,9 @@
 namespace needle {
 
 double EnergyBalance::relative_error() const {
-  const double residual = kinetic_mJ - initial_kinetic_mJ - model_work_mJ - body_work_mJ - constraint_work_mJ;
+  const double residual = kinetic_mJ - initial_kinetic_mJ - model_work_mJ - body_work_mJ - external_work_mJ - constraint_work_mJ;
   const double scale = std::max({std::abs(kinetic_mJ), std::abs(initial_kinetic_mJ), std::abs(model_work_mJ),
-                                 std::abs(body_work_mJ), std::abs(constraint_work_mJ), 1e-300});
+                                 std::abs(body_work_mJ), std::abs(external_work_mJ), std::abs(constraint_work_mJ), 1e-300});
   return std::abs(residual) / scale;
 }
 
@@ -41,6 +41,7 @@ TissueDynamics::TissueDynamics(SpgTissue& tissue, std::vector<VelocityConstraint
   constrained_velocity_before_.resize(constrained_.size());
   constrained_velocity_half_.resize(constrained_.size());
   displacement_.resize(static_cast<size_t>(p.size()));
+  external_force_.assign(static_cast<size_t>(p.size()), Vec3d::Zero());
   tissue_.compute_forces(0.0);
   acceleration_.resize(static_cast<size_t>(p.size()));
   for (std::int64_t i = 0; i < p.size(); ++i)
@@ -71,16 +72,33 @@ double TissueDynamics::kinetic_energy_mJ() const {
   return ke;
 }
 
+void TissueDynamics::set_external_forces(ExternalForces external) {
+  external_ = std::move(external);
+  TissueParticles& p = tissue_.particles();
+  external_force_.assign(static_cast<size_t>(p.size()), Vec3d::Zero());
+  if (external_) external_(external_force_);
+  NEEDLE_REQUIRE(external_force_.size() == static_cast<size_t>(p.size()), "external forces need one force per particle");
+  for (std::int64_t i = 0; i < p.size(); ++i) {
+    const size_t s = static_cast<size_t>(i);
+    acceleration_[s] = (p.force_N[s] + external_force_[s]) / p.mass_g[s] + body_acceleration_;
+  }
+}
+
+double TissueDynamics::time_step_ms(double max_dt_ms) const {
+  const double stable_dt = tissue_.stable_time_step_ms();
+  const double first = steps_ == 0 ? stable_dt : first_dt_ms_;
+  if (!(stable_dt > 1e-4 * first) || !std::isfinite(stable_dt))
+    throw SolverError(fmt::format("the tissue's time step collapsed to {:.3g} ms (first step {:.3g} ms) at t = {:.6g} ms", stable_dt,
+                                  first, time_ms_));
+  return std::min(stable_dt, max_dt_ms);
+}
+
 StepReport TissueDynamics::step(double max_dt_ms) {
   TissueParticles& p = tissue_.particles();
   const std::int64_t n = p.size();
   StepReport report;
-  const double stable_dt = tissue_.stable_time_step_ms();
-  if (steps_ == 0) first_dt_ms_ = stable_dt;
-  if (!(stable_dt > 1e-4 * first_dt_ms_) || !std::isfinite(stable_dt))
-    throw SolverError(fmt::format("time step collapsed to {:.3g} ms (first step {:.3g} ms) at t = {:.6g} ms", stable_dt,
-                                  first_dt_ms_, time_ms_));
-  const double dt = std::min(stable_dt, max_dt_ms);
+  if (steps_ == 0) first_dt_ms_ = tissue_.stable_time_step_ms();
+  const double dt = time_step_ms(max_dt_ms);
   report.dt_ms = dt;
 
   // Half kick, constraints, drift.
@@ -97,6 +115,7 @@ StepReport TissueDynamics::step(double max_dt_ms) {
   std::vector<Vec3d>& old_force = old_force_;
   std::vector<Vec3d>& displacement = displacement_;
   old_force = p.force_N;
+  for (std::int64_t i = 0; i < n; ++i) old_force[static_cast<size_t>(i)] += external_force_[static_cast<size_t>(i)];
   parallel_for(n, [&](std::int64_t begin, std::int64_t end) {
     for (std::int64_t i = begin; i < end; ++i) {
       displacement[static_cast<size_t>(i)] = dt * p.velocity_mm_per_ms[static_cast<size_t>(i)];
@@ -109,16 +128,28 @@ StepReport TissueDynamics::step(double max_dt_ms) {
   report.bonds_broken_now = forces.bonds_broken_now;
   report.rate_factor_capped = forces.rate_factor_capped;
   report.particles_detached_now = forces.particles_detached_now;
-  double model_work = 0, body_work = 0;
+  if (external_) {
+    old_external_force_.swap(external_force_);
+    external_force_.assign(static_cast<size_t>(n), Vec3d::Zero());
+    external_(external_force_);
+  } else {
+    old_external_force_ = external_force_;
+  }
+  // old_force holds internal + external at the step's start; split the trapezoid sums accordingly.
+  double model_work = 0, body_work = 0, external_work = 0;
   for (std::int64_t i = 0; i < n; ++i) {
     const size_t s = static_cast<size_t>(i);
-    if (!p.force_N[s].allFinite()) throw SolverError(fmt::format("non-finite force on particle {} at t = {:.6g} ms", i, time_ms_));
-    model_work += 0.5 * (old_force[s] + p.force_N[s]).dot(displacement[s]);
+    if (!p.force_N[s].allFinite() || !external_force_[s].allFinite())
+      throw SolverError(fmt::format("non-finite force on particle {} at t = {:.6g} ms", i, time_ms_));
+    const Vec3d old_internal = old_force[s] - old_external_force_[s];
+    model_work += 0.5 * (old_internal + p.force_N[s]).dot(displacement[s]);
+    external_work += 0.5 * (old_external_force_[s] + external_force_[s]).dot(displacement[s]);
     body_work += p.mass_g[s] * body_acceleration_.dot(displacement[s]);
-    acceleration_[s] = p.force_N[s] / p.mass_g[s] + body_acceleration_;
+    acceleration_[s] = (p.force_N[s] + external_force_[s]) / p.mass_g[s] + body_acceleration_;
   }
   energy_.model_work_mJ += model_work;
   energy_.body_work_mJ += body_work;
+  energy_.external_work_mJ += external_work;
   kick(0.5 * dt, time_ms_);
   // Reactions on constrained components: R = m dv/dt - f over the step, working through the displacement.
   double constraint_work = 0;
@@ -128,7 +159,7 @@ StepReport TissueDynamics::step(double max_dt_ms) {
       if (!(constrained_mask_[s] & (1 << axis))) continue;
       constraint_work += p.mass_g[s] * (p.velocity_mm_per_ms[s][axis] - constrained_velocity_before[k][axis]) *
                              constrained_velocity_half[k][axis] -
-                         0.5 * (old_force[s][axis] + p.force_N[s][axis]) * displacement[s][axis];
+                         0.5 * (old_force[s][axis] + p.force_N[s][axis] + external_force_[s][axis]) * displacement[s][axis];
     }
   }
   energy_.constraint_work_mJ += constraint_work;

@@ -27,9 +27,10 @@ struct EnergyBalance {
   double kinetic_mJ = 0;
   double model_work_mJ = 0;        // work of internal and stabilization forces (= - stored and dissipated energy)
   double body_work_mJ = 0;
+  double external_work_mJ = 0;     // work of external forces (contact with the needle)
   double constraint_work_mJ = 0;
   double initial_kinetic_mJ = 0;
-  // |KE - KE0 - W_model - W_body - W_constraint| / max(|terms|): the integrator's drift
+  // |KE - KE0 - W_model - W_body - W_external - W_constraint| / max(|terms|): the integrator's drift
   double relative_error() const;
 };
 
@@ -45,6 +46,14 @@ class TissueDynamics {
   TissueDynamics(SpgTissue& tissue, std::vector<VelocityConstraint> constraints,
                  const Eigen::Vector3d& body_acceleration_mm_per_ms2 = Eigen::Vector3d::Zero());
 
+  // External forces (contact): called with the particles at their new positions after every drift (and
+  // once now) to fill one force per particle; they act like internal forces in the step, and their work
+  // is booked apart.
+  using ExternalForces = std::function<void(std::vector<Vec3d>& force_N)>;
+  void set_external_forces(ExternalForces external);
+
+  // The step the next step() will take: the tissue's stable step capped at max_dt_ms.
+  double time_step_ms(double max_dt_ms = std::numeric_limits<double>::infinity()) const;
   // One step with the tissue's stable time step, capped at max_dt_ms (> 0). SolverError on blow-up or a
   // collapsed time step (below 1e-4 of the first).
   StepReport step(double max_dt_ms = std::numeric_limits<double>::infinity());
@@ -52,6 +61,7 @@ class TissueDynamics {
   double time_ms() const { return time_ms_; }
   std::int64_t steps() const { return steps_; }
   const EnergyBalance& energy() const { return energy_; }
+  const std::vector<Vec3d>& external_forces() const { return external_force_; }
   // Sum over a constraint's particles of the force the tissue exerts on them (N): minus the reaction.
   Eigen::Vector3d constraint_internal_force_N(size_t constraint) const;
 
@@ -70,6 +80,8 @@ class TissueDynamics {
   std::vector<std::uint8_t> constrained_mask_;  // per particle: bit k = component k constrained
   // Step scratch, kept to avoid allocating per step.
   std::vector<Vec3d> old_force_, displacement_, constrained_velocity_before_, constrained_velocity_half_;
+  ExternalForces external_;
+  std::vector<Vec3d> external_force_, old_external_force_;
 };
 
 }  // namespace needle

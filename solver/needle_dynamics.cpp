@@ -10,9 +10,9 @@
 namespace needle {
 
 double NeedleEnergy::balance_error() const {
-  const double residual = kinetic_mJ + strain_mJ - initial_mJ - drive_work_mJ - cannula_work_mJ;
+  const double residual = kinetic_mJ + strain_mJ - initial_mJ - drive_work_mJ - cannula_work_mJ - external_work_mJ;
   const double scale = std::max({std::abs(kinetic_mJ), std::abs(strain_mJ), std::abs(initial_mJ), std::abs(drive_work_mJ),
-                                 std::abs(cannula_work_mJ), 1e-300});
+                                 std::abs(cannula_work_mJ), std::abs(external_work_mJ), 1e-300});
   return std::abs(residual) / scale;
 }
 
@@ -24,6 +24,12 @@ NeedleDynamics::NeedleDynamics(const FeNeedle& needle, NeedleSupports supports, 
   NEEDLE_REQUIRE(supports_.direction.allFinite() && supports_.direction.norm() > 0, "drive direction must be a non-zero vector");
   supports_.direction.normalize();
   const int n = needle.num_nodes();
+  if (options_.rigid) {
+    supports_.driven.resize(static_cast<size_t>(n));
+    for (int i = 0; i < n; ++i) supports_.driven[static_cast<size_t>(i)] = i;
+    supports_.clamped.clear();
+    supports_.symmetry.clear();
+  }
   mask_.assign(static_cast<size_t>(n), 0);
   auto mark = [&](const std::vector<int>& nodes, std::uint8_t bits, const char* what) {
     for (int i : nodes) {
@@ -37,9 +43,9 @@ NeedleDynamics::NeedleDynamics(const FeNeedle& needle, NeedleSupports supports, 
   for (int i = 0; i < n; ++i)
     if (mask_[static_cast<size_t>(i)]) constrained_.push_back(i);
   v_before_.resize(static_cast<Eigen::Index>(constrained_.size()), 3);
-  dt_ms_ = options_.courant * needle.stable_time_step_ms();
+  dt_ms_ = options_.rigid ? std::numeric_limits<double>::infinity() : options_.courant * needle.stable_time_step_ms();
   mass_ = needle.nodal_mass_g();
-  if (cannula && cannula->enabled) cannula_.emplace(*cannula, boundary_nodes(needle.mesh()), mass_, dt_ms_);
+  if (cannula && cannula->enabled && !options_.rigid) cannula_.emplace(*cannula, boundary_nodes(needle.mesh()), mass_, dt_ms_);
   x_ = needle.mesh().X;
   v_ = Eigen::MatrixX3d::Zero(n, 3);
   compute_forces(v_);
@@ -63,6 +69,24 @@ void NeedleDynamics::set_initial_state(const Eigen::MatrixX3d& x, const Eigen::M
   energy_.initial_mJ = energy_.kinetic_mJ + energy_.strain_mJ;
 }
 
+void NeedleDynamics::set_external_forces(ExternalForces external) {
+  for (const auto& [node, f] : external_) force_.row(node) -= f.transpose();
+  external_.clear();
+  external_fn_ = std::move(external);
+  if (external_fn_) {
+    external_fn_(x_, v_, time_ms_, external_);
+    for (const auto& [node, f] : external_) {
+      NEEDLE_REQUIRE(node >= 0 && node < x_.rows(), "external needle force on a node that does not exist");
+      force_.row(node) += f.transpose();
+    }
+  }
+  a_ = force_.array().colwise() / mass_.array();
+}
+
+void NeedleDynamics::advance_to(double end_time_ms) {
+  while (time_ms_ < end_time_ms - 1e-12 * std::max(1.0, std::abs(end_time_ms))) step(end_time_ms);
+}
+
 void NeedleDynamics::apply_supports(Eigen::MatrixX3d& v, double t) const {
   const Eigen::RowVector3d drive = (supports_.profile.velocity_mm_per_ms(t) * supports_.direction).transpose();
   for (int i : supports_.clamped) v.row(i).setZero();
@@ -71,10 +95,21 @@ void NeedleDynamics::apply_supports(Eigen::MatrixX3d& v, double t) const {
 }
 
 void NeedleDynamics::compute_forces(const Eigen::MatrixX3d& velocity) {
-  energy_.strain_mJ = needle_.internal_forces(x_, force_);
+  if (options_.rigid) {
+    force_.setZero(x_.rows(), 3);
+    energy_.strain_mJ = 0;
+  } else {
+    energy_.strain_mJ = needle_.internal_forces(x_, force_);
+  }
   cannula_force_.setZero(force_.rows(), 3);  // no allocation once sized
   if (cannula_) contact_ = cannula_->add_forces(x_, velocity, cannula_force_);
   force_ += cannula_force_;
+  old_external_.swap(external_);
+  external_.clear();
+  if (external_fn_) {
+    external_fn_(x_, velocity, time_ms_, external_);
+    for (const auto& [node, f] : external_) force_.row(node) += f.transpose();
+  }
   if (!force_.allFinite() || !std::isfinite(energy_.strain_mJ))
     throw SolverError(fmt::format("the needle's forces became non-finite at t = {:.6g} ms (step {})", time_ms_, steps_));
   if (contact_.max_penetration_mm > options_.max_penetration_mm)
@@ -105,6 +140,10 @@ void NeedleDynamics::step(double end_time_ms) {
   // Work over the step: the cannula's by the trapezoid rule; the reactions' on prescribed components
   // from R dt = m (v(n+1) - v(n)) - (f(n) + f(n+1)) dt / 2, through dx = v(n+1/2) dt.
   energy_.cannula_work_mJ += 0.5 * dt * ((old_cannula_force_ + cannula_force_).cwiseProduct(v_half_)).sum();
+  double external_work = 0;
+  for (const NodalForces* list : {&old_external_, &external_})
+    for (const auto& [node, f] : *list) external_work += 0.5 * dt * f.dot(v_half_.row(node).transpose());
+  energy_.external_work_mJ += external_work;
   double drive_work = 0;
   drive_reaction_.setZero();
   for (size_t c = 0; c < constrained_.size(); ++c) {
@@ -117,12 +156,17 @@ void NeedleDynamics::step(double end_time_ms) {
       drive_reaction_[k] += impulse / dt;
     }
   }
-  energy_.drive_work_mJ += drive_work;
+  const double kinetic_before = energy_.kinetic_mJ;
   energy_.kinetic_mJ = 0.5 * mass_.dot(v_.rowwise().squaredNorm());
+  // A rigid needle's step may span a kink of the profile, where the mean velocity is not the mid-step one:
+  // its drive work is exactly what the motion needs, the change of kinetic energy less the other forces' work.
+  if (options_.rigid) drive_work = energy_.kinetic_mJ - kinetic_before - external_work;
+  energy_.drive_work_mJ += drive_work;
+  drive_impulse_ += dt * drive_reaction_;
   ++steps_;
   if (!std::isfinite(energy_.kinetic_mJ))
     throw SolverError(fmt::format("the needle's kinetic energy became non-finite at t = {:.6g} ms", time_ms_));
-  const double work_scale = std::max(std::abs(energy_.drive_work_mJ), std::abs(energy_.cannula_work_mJ));
+  const double work_scale = std::max({std::abs(energy_.drive_work_mJ), std::abs(energy_.cannula_work_mJ), std::abs(energy_.external_work_mJ)});
   if (work_scale > 1e-6 && energy_.balance_error() > options_.max_energy_error)  // relative error of nJ is noise
     throw SolverError(fmt::format("the needle's energy balance drifted by {:.3g} % at t = {:.6g} ms (limit {:.3g} %)",
                                   100 * energy_.balance_error(), time_ms_, 100 * options_.max_energy_error));

@@ -9,7 +9,9 @@
 // whose relative error is the integrator's drift. The run stops with a SolverError (never NaN) on a
 // non-finite state, on energy drift beyond a bound, or on cannula penetration beyond a bound.
 #include <Eigen/Dense>
+#include <functional>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "solver/fe_needle.h"
@@ -30,12 +32,16 @@ struct NeedleDynamicsOptions {
   double courant = 0.9;                 // fraction of the stable step used
   double max_energy_error = 0.05;       // stop when the balance error exceeds this (after the first work)
   double max_penetration_mm = 0.05;     // stop when a node passes the cannula's bore by more
+  // A rigid needle: every node follows the drive, no elastic forces, no cannula, and no step limit
+  // (step() goes straight to its end time). Model only what a scene needs: tissue studies that do not
+  // ask for deflection.
+  bool rigid = false;
 };
 
 struct NeedleEnergy {
   double kinetic_mJ = 0, strain_mJ = 0, initial_mJ = 0;
-  double drive_work_mJ = 0, cannula_work_mJ = 0;
-  // |KE + U - E0 - W_drive - W_cannula| / the largest of those terms.
+  double drive_work_mJ = 0, cannula_work_mJ = 0, external_work_mJ = 0;
+  // |KE + U - E0 - W_drive - W_cannula - W_external| / the largest of those terms.
   double balance_error() const;
 };
 
@@ -47,8 +53,17 @@ class NeedleDynamics {
   double time_step_ms() const { return dt_ms_; }
   // Replaces the state before the first step (a pre-deformed or moving start); InputError after.
   void set_initial_state(const Eigen::MatrixX3d& x_mm, const Eigen::MatrixX3d& v_mm_per_ms);
+  // External nodal forces (the tissue's contact): a function evaluated with the elastic forces at every
+  // step (positions, mid-step velocities, time) that lists (node, force) pairs. Set it before the
+  // first step or between steps; it is evaluated once at once.
+  using NodalForces = std::vector<std::pair<int, Eigen::Vector3d>>;
+  using ExternalForces = std::function<void(const Eigen::MatrixX3d& x_mm, const Eigen::MatrixX3d& v_mm_per_ms, double time_ms,
+                                            NodalForces& force_N)>;
+  void set_external_forces(ExternalForces external);
   // One step of time_step_ms() (shortened to land on end_time_ms if given).
   void step(double end_time_ms = std::numeric_limits<double>::infinity());
+  // Steps until end_time_ms (subcycling within a longer step of another body).
+  void advance_to(double end_time_ms);
 
   double time_ms() const { return time_ms_; }
   long steps() const { return steps_; }
@@ -59,6 +74,10 @@ class NeedleDynamics {
   const CannulaContact& cannula_contact() const { return contact_; }
   // Force the drive applies to the needle through the driven nodes (N): m a - f over those nodes.
   Eigen::Vector3d drive_reaction_N() const { return drive_reaction_; }
+  // Its time integral since the start (N ms = g mm/ms): the momentum the drive has put in.
+  Eigen::Vector3d drive_impulse_N_ms() const { return drive_impulse_; }
+  // Total momentum of the needle (g mm/ms).
+  Eigen::Vector3d momentum() const { return (v_.array().colwise() * mass_.array()).colwise().sum().transpose(); }
   // Where the driven base has moved the needle rigidly: d(t) direction.
   Eigen::Vector3d drive_displacement_mm() const { return supports_.profile.displacement_mm(time_ms_) * supports_.direction; }
   const FeNeedle& needle() const { return needle_; }
@@ -74,6 +93,8 @@ class NeedleDynamics {
   double dt_ms_ = 0, time_ms_ = 0;
   long steps_ = 0;
   Eigen::MatrixX3d x_, v_, a_, force_, old_force_, cannula_force_, old_cannula_force_;
+  ExternalForces external_fn_;
+  NodalForces external_, old_external_;
   Eigen::MatrixX3d v_before_;  // step scratch: velocities of the constrained nodes before the step
   Eigen::MatrixX3d v_half_;
   Eigen::VectorXd mass_;
@@ -82,6 +103,7 @@ class NeedleDynamics {
   NeedleEnergy energy_;
   CannulaContact contact_;
   Eigen::Vector3d drive_reaction_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d drive_impulse_ = Eigen::Vector3d::Zero();
 };
 
 }  // namespace needle

@@ -93,7 +93,7 @@ TEST_CASE("needle simulate: bad scenes exit non-zero and leave no run folder", "
   const fs::path dir = fresh_folder("bad");
   const std::vector<std::string> scenes = {
       R"({"motion": {"sped_m_per_s": 8}})", R"({"needle": {"material": {"youngs_modulus_MPa": -1}}})",
-      R"({"needle": {"mesh_file": "missing.msh"}})", R"({"motion": {"travel": 30}})", R"({"tissue": {"enabled": true}})"};
+      R"({"needle": {"mesh_file": "missing.msh"}})", R"({"motion": {"travel": 30}})", R"({"tissue": {"enabled": true, "contact": {"stifness_factor": 5}}})"};
   for (size_t i = 0; i < scenes.size(); ++i) {
     write(dir / "scene.json", scenes[i]);
     const auto r = run("simulate " + (dir / "scene.json").string() + " --out " + (dir / "run").string(), true);
@@ -160,4 +160,48 @@ TEST_CASE("needle stiffness --json reports compliance and frequencies with the b
   CHECK(j["frequency_y_hz"].get<double>() > 0);
   CHECK(run("stiffness --plain-rod --free-length-mm -3").exit_code == 2);
   CHECK(run("stiffness --preset XX").exit_code == 2);
+}
+
+TEST_CASE("needle run: a rod pushed into a small tissue block writes the coupled run folder", "[apps][lspg][gmsh]") {
+  const fs::path dir = fresh_folder("insertion");
+  write(dir / "scene.json", R"({
+    "needle": {"plain_rod": true, "length_mm": 6, "mesh": {"order": 1, "size_mm": 0.5}},
+    "motion": {"accel_time_ms": 0.02, "travel_mm": 1.0},
+    "cannula": {"enabled": false},
+    "tissue": {"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4},
+    "solver": {"mass_scaling_dt_ms": 1e-5},
+    "output": {"frames": 2, "history_interval_ms": 0.02}
+  })");
+  const auto r = run("run --scene " + (dir / "scene.json").string() + " --out " + (dir / "run").string() + " --quiet", true);
+  INFO(r.out);
+  REQUIRE(r.exit_code == 0);
+  for (const char* file : {"scene.json", "history.csv", "facet_forces.csv", "summary.json", "needle.pvd", "tissue.pvd", "run.log",
+                           "frames/tissue_0002.vtp", "frames/needle_0002.vtu"})
+    CHECK(fs::exists(dir / "run" / file));
+  std::ifstream in(dir / "run" / "summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(in);
+  CHECK(summary["status"] == "finished");
+  CHECK(summary["insertion_mm"].get<double>() == Approx(1.0));
+  CHECK(summary["particles_inside"].get<int>() == 0);
+  CHECK(summary["energy_balance_error"].get<double>() < 0.02);
+  CHECK(summary["steps"].get<long>() < summary["needle_steps"].get<long>());  // the needle subcycled
+  for (const char* key : {"deflection_mm", "runtime_s", "peak_memory_MiB", "max_penetration_mm", "max_energy_balance_error"})
+    CHECK(summary.contains(key));
+  // The tissue frames carry the particle fields.
+  std::ifstream vtp(dir / "run" / "frames" / "tissue_0002.vtp");
+  const std::string text((std::istreambuf_iterator<char>(vtp)), std::istreambuf_iterator<char>());
+  for (const char* field : {"displacement_mm", "plastic_strain", "broken_bonds", "in_contact"}) CHECK(text.find(field) != std::string::npos);
+}
+
+TEST_CASE("needle run: no needle, two needles or a bad number exit 2 with one line and no folder", "[apps][lspg]") {
+  const fs::path dir = fresh_folder("run_bad");
+  for (const std::string& args : {"run --out " + (dir / "a").string(), "run --preset SB --d-a 0 --out " + (dir / "a").string(),
+                                 "run --preset SB --travel-mm -3 --out " + (dir / "a").string(),
+                                 "run --preset XX --out " + (dir / "a").string()}) {
+    const auto r = run(args, true);
+    INFO(args << " -> " << r.out);
+    CHECK(r.exit_code == 2);
+    CHECK(std::count(r.out.begin(), r.out.end(), '\n') == 1);
+    CHECK_FALSE(fs::exists(dir / "a"));
+  }
 }

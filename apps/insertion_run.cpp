@@ -1,0 +1,265 @@
+#include "apps/insertion_run.h"
+
+#include <chrono>
+#include <fmt/format.h>
+#include <fstream>
+
+#include "apps/run_folder.h"
+#include "apps/scene_needle.h"
+#include "geometry/input_error.h"
+#include "mesher/particle_lattice.h"
+#include "mesher/vtk_files.h"
+#include "solver/lspg_insertion.h"
+#include "solver/parallel.h"
+#include "solver/solver_error.h"
+
+namespace needle {
+namespace {
+
+using nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+ParticleSet scene_particles(const Scene& scene) {
+  const TissueScene& t = scene.tissue;
+  TissueBox box;
+  const bool half = scene.needle.half_model;
+  box.min_mm = {t.entry_x_mm, -0.5 * t.size_mm.y(), half ? 0.0 : -t.size_mm.z()};
+  box.max_mm = {t.entry_x_mm + t.size_mm.x(), 0.5 * t.size_mm.y(), t.size_mm.z()};
+  if (!half) box.faces[4] = FaceCondition::fixed;
+  LatticeOptions lattice;
+  lattice.spacing_mm = t.spacing_mm;
+  return make_particle_lattice(box, lattice);
+}
+
+// Broken bonds per particle.
+Eigen::VectorXd broken_bonds(const SpgTissue& tissue) {
+  Eigen::VectorXd count = Eigen::VectorXd::Zero(tissue.particles().size());
+  for (const Bond& b : tissue.bonds().bonds)
+    if (b.broken) {
+      count[b.i] += 1;
+      count[b.j] += 1;
+    }
+  return count;
+}
+
+class InsertionOutput {
+ public:
+  InsertionOutput(const RunFolder& folder, const ContactSurface& surface) : folder_(folder), surface_(surface) {
+    history_.open(folder.path("history.csv"));
+    history_ << "time_ms,insertion_mm,tip_dx_mm,tip_dy_mm,tip_dz_mm,deflection_mm,drive_force_x_N,drive_force_y_N,drive_force_z_N,"
+                "contact_force_x_N,contact_force_y_N,contact_force_z_N,particles_in_contact,particles_inside,max_depth_mm,"
+                "bonds_broken,tissue_kinetic_mJ,tissue_internal_mJ,needle_kinetic_mJ,needle_strain_mJ,drive_work_mJ,"
+                "cannula_work_mJ,contact_work_mJ,penalty_energy_mJ,friction_dissipation_mJ,energy_balance_error,"
+                "coupling_step_ms,needle_steps\n";
+    facets_.open(folder.path("facet_forces.csv"));
+    facets_ << "time_ms,insertion_mm";
+    for (const std::string& tag : surface.tag_names())
+      if (tag != "symmetry")
+        facets_ << fmt::format(",{0}_particles,{0}_normal_N,{0}_friction_N,{0}_fx_N,{0}_fy_N,{0}_fz_N", tag);
+    facets_ << "\n";
+  }
+
+  void record(const LspgInsertion& run, int tip) {
+    const NeedleDynamics& n = run.needle();
+    const Eigen::RowVector3d u = n.positions_mm().row(tip) - n.needle().mesh().X.row(tip);
+    const Eigen::Vector3d drive = n.drive_displacement_mm(), reaction = n.drive_reaction_N();
+    const ContactReport& c = run.contact();
+    const InsertionEnergy& e = run.energy();
+    history_ << fmt::format(
+        "{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{},{},{:.6g},{},{:.9g},{:.9g},{:.9g},{:.9g},"
+        "{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.6g},{:.6g},{}\n",
+        run.time_ms(), drive.norm(), u.x(), u.y(), u.z(), u.y() - drive.y(), reaction.x(), reaction.y(), reaction.z(),
+        c.force_on_needle_N.x(), c.force_on_needle_N.y(), c.force_on_needle_N.z(), c.particles_in_contact, c.particles_inside,
+        c.max_depth_mm, run.bonds_broken(), e.tissue_kinetic_mJ, e.tissue_internal_mJ, e.needle_kinetic_mJ, e.needle_strain_mJ,
+        e.drive_work_mJ, e.cannula_work_mJ, e.contact_work_mJ, e.penalty_energy_mJ, e.friction_dissipation_mJ, e.balance_error(),
+        run.last_step_ms(), run.needle_steps());
+    facets_ << fmt::format("{:.9g},{:.9g}", run.time_ms(), drive.norm());
+    for (size_t k = 0; k < surface_.tag_names().size(); ++k) {
+      if (surface_.tag_names()[k] == "symmetry") continue;
+      const FacetContact& f = c.facets[k];
+      facets_ << fmt::format(",{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}", f.particles, f.normal_N, f.friction_N, f.force_N.x(), f.force_N.y(),
+                             f.force_N.z());
+    }
+    facets_ << "\n";
+  }
+
+  void frame(const LspgInsertion& run) {
+    const int index = static_cast<int>(needle_frames_.size());
+    const NeedleDynamics& n = run.needle();
+    TetMesh deformed = n.needle().mesh();
+    deformed.X = n.positions_mm();
+    const ElementStresses stresses = n.needle().element_stresses(n.positions_mm());
+    const std::string needle_name = fmt::format("frames/needle_{:04}.vtu", index);
+    write_vtu(folder_.path(needle_name).string(), deformed,
+              {{"von_mises_MPa", stresses.von_mises_MPa}, {"cauchy_stress_MPa", stresses.cauchy_MPa}},
+              {{"displacement_mm", n.displacements_mm()}, {"velocity_m_per_s", n.velocities_mm_per_ms()}});
+    needle_frames_.emplace_back(run.time_ms(), needle_name);
+
+    const TissueParticles& p = run.tissue().particles();
+    const Eigen::Index np = p.size();
+    Eigen::MatrixX3d x(np, 3), u(np, 3), v(np, 3);
+    Eigen::VectorXd plastic(np), mises(np), contact(np);
+    const std::vector<std::uint8_t> in_contact = run.contact_model().in_contact();
+    for (Eigen::Index i = 0; i < np; ++i) {
+      const size_t s = static_cast<size_t>(i);
+      x.row(i) = p.position_mm[s].transpose();
+      u.row(i) = (p.position_mm[s] - p.initial_mm[s]).transpose();
+      v.row(i) = p.velocity_mm_per_ms[s].transpose();
+      plastic[i] = p.plastic_strain[s];
+      const Mat3d dev = p.stress_MPa[s] - p.stress_MPa[s].trace() / 3 * Mat3d::Identity();
+      mises[i] = std::sqrt(1.5 * dev.squaredNorm());
+      contact[i] = in_contact[s];
+    }
+    const std::string tissue_name = fmt::format("frames/tissue_{:04}.vtp", index);
+    write_vtp(folder_.path(tissue_name).string(), x,
+              {{"displacement_mm", u}, {"velocity_m_per_s", v}, {"plastic_strain", plastic}, {"von_mises_MPa", mises},
+               {"broken_bonds", broken_bonds(run.tissue())}, {"in_contact", contact}});
+    tissue_frames_.emplace_back(run.time_ms(), tissue_name);
+  }
+
+  void finish() {
+    history_.close();
+    facets_.close();
+    write_pvd(folder_.path("needle.pvd"), needle_frames_);
+    write_pvd(folder_.path("tissue.pvd"), tissue_frames_);
+  }
+
+ private:
+  const RunFolder& folder_;
+  const ContactSurface& surface_;
+  std::ofstream history_, facets_;
+  std::vector<std::pair<double, std::string>> needle_frames_, tissue_frames_;
+};
+
+}  // namespace
+
+void run_insertion(const Scene& scene, const RunOptions& o) {
+  NEEDLE_REQUIRE(scene.tissue.enabled, "run_insertion needs a scene with tissue.enabled");
+  const ThreadLimit threads(o.threads >= 0 ? o.threads : scene.solver.threads);
+  // Everything that can be wrong with the input is found before the run folder exists.
+  const auto start = Clock::now();
+  const SceneNeedle built = build_scene_needle(scene.needle);
+  const FeNeedle needle(built.mesh, scene.needle.material, scene.needle.rigid ? 0.0 : scene.solver.mass_scaling_dt_ms);
+  ContactSurfaceOptions surface_options;
+  surface_options.voxel_mm = scene.tissue.contact.voxel_mm;
+  const ContactSurface surface(needle.mesh(), surface_options);
+  const ParticleSet particles = scene_particles(scene);
+  SpgTissue tissue(particles, scene.tissue.material, scene.tissue.spg);
+  const double setup_s = std::chrono::duration<double>(Clock::now() - start).count();
+
+  RunFolder folder(o.out_dir, o.overwrite);
+  std::filesystem::create_directories(folder.path("frames"));
+  RunLog log(folder.path("run.log"));
+  {
+    std::ofstream effective(folder.path("scene.json"));
+    effective << scene_to_json(scene).dump(2) << "\n";
+  }
+  log.line(fmt::format("scene {}", scene.source));
+  log.line(fmt::format("needle {}: {} T{} elements, {} nodes, meshed in {:.2f} s{}", built.name, built.mesh.num_tets(),
+                       built.mesh.order == 2 ? 10 : 4, built.mesh.num_nodes(), built.mesh_seconds, scene.needle.rigid ? " (rigid)" : ""));
+  log.line(fmt::format("needle stable step {:.4g} ms (unscaled {:.4g} ms); added mass {:.3g} % in {} elements", needle.stable_time_step_ms(),
+                       needle.unscaled_time_step_ms(), 100 * needle.added_mass_g() / needle.physical_mass_g(), needle.mass_scaled_elements()));
+  log.line(fmt::format("contact surface: {} triangles, level set {} voxels of {} mm ({:.1f} MiB) built in {:.2f} s", surface.num_triangles(),
+                       surface.level_set().active_voxels(), surface.level_set().voxel_mm(), surface.level_set().memory_bytes() / 1048576.0,
+                       surface.level_set().build_seconds()));
+  log.line(fmt::format("tissue: {} particles at {} mm, {} bonds; set-up {:.2f} s", particles.num_particles(), scene.tissue.spacing_mm,
+                       tissue.bonds().bonds.size(), setup_s));
+
+  NeedleSupports supports;
+  supports.driven = nodes_with_tag(needle.mesh(), "base");
+  if (needle.mesh().tag_index("symmetry") >= 0) supports.symmetry = nodes_with_tag(needle.mesh(), "symmetry");
+  supports.profile = scene.motion;
+  supports.direction = scene.direction;
+  NeedleDynamicsOptions dynamics;
+  dynamics.courant = scene.solver.courant;
+  dynamics.max_energy_error = scene.solver.max_energy_error;
+  dynamics.max_penetration_mm = scene.solver.max_penetration_mm;
+  dynamics.rigid = scene.needle.rigid;
+  NeedleDynamics needle_run(needle, supports, scene.cannula.enabled ? std::optional<CannulaOptions>(scene.cannula) : std::nullopt,
+                            dynamics);
+  LspgInsertion run(needle_run, tissue, surface, scene.tissue.contact, scene.solver.coupling);
+  const int tip = nearest_node(needle.mesh(), built.tip_point);
+  const double end_ms = scene.motion.end_time_ms();
+  log.line(fmt::format("run to {:.6g} ms: needle step {:.4g} ms, first coupling step {:.4g} ms (tissue {:.4g}, contact {:.4g})", end_ms,
+                       needle_run.time_step_ms(), run.tissue_dynamics().time_step_ms(), tissue.stable_time_step_ms(),
+                       scene.solver.coupling.contact_courant * run.contact_model().stable_time_step_ms()));
+
+  InsertionOutput output(folder, surface);
+  output.record(run, tip);
+  if (scene.output.frames > 0) output.frame(run);
+  ProgressBar progress(end_ms, o.quiet);
+  std::string status = "finished", reason;
+  double next_history = scene.output.history_interval_ms;
+  int next_frame = 1;
+  const auto solve_start = Clock::now();
+  try {
+    while (run.time_ms() < end_ms - 1e-12) {
+      run.step(end_ms);
+      if (run.time_ms() >= next_history - 1e-12 || run.time_ms() >= end_ms - 1e-12) {
+        output.record(run, tip);
+        next_history += scene.output.history_interval_ms;
+      }
+      if (scene.output.frames > 0 && run.time_ms() >= next_frame * end_ms / scene.output.frames - 1e-12) {
+        output.frame(run);
+        ++next_frame;
+      }
+      progress.update(run.time_ms(), run.steps(), "ms");
+    }
+  } catch (const SolverError& e) {
+    status = "stopped";
+    reason = e.what();
+    output.record(run, tip);
+  }
+  progress.finish();
+  const double solve_s = std::chrono::duration<double>(Clock::now() - solve_start).count();
+  output.finish();
+
+  const Eigen::RowVector3d u = needle_run.positions_mm().row(tip) - needle.mesh().X.row(tip);
+  const double deflection = u.y() - needle_run.drive_displacement_mm().y();
+  const InsertionEnergy& e = run.energy();
+  const json summary = {
+      {"status", status},
+      {"reason", reason},
+      {"needle", built.name},
+      {"deflection_mm", deflection},
+      {"tip_displacement_mm", {u.x(), u.y(), u.z()}},
+      {"insertion_mm", needle_run.drive_displacement_mm().norm()},
+      {"time_ms", run.time_ms()},
+      {"steps", run.steps()},
+      {"needle_steps", run.needle_steps()},
+      {"needle_time_step_ms", needle_run.time_step_ms()},
+      {"unscaled_needle_time_step_ms", needle.unscaled_time_step_ms()},
+      {"added_mass_percent", 100 * needle.added_mass_g() / needle.physical_mass_g()},
+      {"subcycling", scene.solver.coupling.subcycling},
+      {"energy_balance_error", e.balance_error()},
+      {"max_energy_balance_error", run.max_energy_error()},
+      {"energy_mJ", {{"drive_work", e.drive_work_mJ}, {"tissue_internal", e.tissue_internal_mJ}, {"tissue_kinetic", e.tissue_kinetic_mJ},
+                     {"needle_kinetic", e.needle_kinetic_mJ}, {"needle_strain", e.needle_strain_mJ}, {"contact_work", e.contact_work_mJ},
+                     {"penalty", e.penalty_energy_mJ}, {"friction_dissipation", e.friction_dissipation_mJ}, {"cannula_work", e.cannula_work_mJ}}},
+      {"max_penetration_mm", run.max_depth_mm()},
+      {"particles_inside", run.contact().particles_inside},
+      {"max_particles_inside", run.max_particles_inside()},
+      {"particles", particles.num_particles()},
+      {"bonds_broken", run.bonds_broken()},
+      {"runtime_s", std::chrono::duration<double>(Clock::now() - start).count()},
+      {"solve_s", solve_s},
+      {"peak_memory_MiB", peak_memory_MiB()},
+      {"mesh", {{"order", needle.mesh().order}, {"elements", needle.num_elements()}, {"nodes", needle.num_nodes()}}},
+      {"threads", hardware_threads()},
+  };
+  {
+    std::ofstream out(folder.path("summary.json"));
+    out << summary.dump(2) << "\n";
+  }
+  log.line(fmt::format("{}{}: deflection {:.6g} mm after {} coupling steps and {} needle steps in {:.2f} s, energy balance error {:.3g}, "
+                       "max penetration {:.3g} mm, {} particles inside at the end",
+                       status, reason.empty() ? "" : " (" + reason + ")", deflection, run.steps(), run.needle_steps(), solve_s,
+                       e.balance_error(), run.max_depth_mm(), run.contact().particles_inside));
+  folder.commit();
+  if (!o.quiet)
+    fmt::print("{} {}: deflection {:.6g} mm, {} steps ({} needle steps), {:.1f} s -> {}\n", built.name, status, deflection, run.steps(),
+               run.needle_steps(), solve_s, folder.final_path().string());
+  if (status != "finished") throw SolverError(reason + fmt::format(" (what was written so far is in {})", o.out_dir));
+}
+
+}  // namespace needle
