@@ -123,6 +123,8 @@ void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc) {
     t.contact.stiffness_factor = c.number("stiffness_factor", t.contact.stiffness_factor, within(1e-3, 1e4));
     t.contact.skin_mm = c.quantity("skin", Dimension::length, t.contact.skin_mm, non_negative());
     t.contact.voxel_mm = c.quantity("voxel", Dimension::length, t.contact.voxel_mm, within(1e-3, 0.2));
+    t.contact.damping_ratio = c.number("damping_ratio", t.contact.damping_ratio, within(0.0, 1.0));
+    t.contact.needle_stiffness_scale = c.number("needle_stiffness_scale", t.contact.needle_stiffness_scale, within(1e-6, 0.5));
     c.finish();
   }
   o.finish();
@@ -202,7 +204,8 @@ json scene_to_json(const Scene& s) {
                {"failure_plastic_strain", t.spg.bond_failure.plastic_strain},
                {"failure_stretch_ratio", t.spg.bond_failure.stretch_ratio},
                {"cfl", t.spg.cfl}}},
-      {"contact", {{"stiffness_factor", t.contact.stiffness_factor}, {"skin_mm", t.contact.skin_mm}, {"voxel_mm", t.contact.voxel_mm}}}};
+      {"contact", {{"stiffness_factor", t.contact.stiffness_factor}, {"skin_mm", t.contact.skin_mm}, {"voxel_mm", t.contact.voxel_mm},
+                   {"damping_ratio", t.contact.damping_ratio}, {"needle_stiffness_scale", t.contact.needle_stiffness_scale}}}};
   const CannulaOptions& c = s.cannula;
   return {
       {"needle", needle},

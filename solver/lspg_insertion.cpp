@@ -89,7 +89,10 @@ void LspgInsertion::step(double end_time_ms) {
   if (options_.max_step_ms > 0) cap = std::min(cap, options_.max_step_ms);
   cap = std::min(cap, options_.contact_courant * contact_.stable_time_step_ms());
   if (!options_.subcycling) cap = std::min(cap, needle_.time_step_ms());
-  const double dt = tissue_dynamics_.time_step_ms(cap);
+  double dt = tissue_dynamics_.time_step_ms(cap);
+  // A whole number of needle steps per coupling step, so that the needle never takes a sliver of a step.
+  const double needle_dt = needle_.time_step_ms();
+  if (std::isfinite(needle_dt) && dt > needle_dt && dt < end_time_ms - t) dt = std::floor(dt / needle_dt) * needle_dt;
   step_start_ms_ = t;
   step_dt_ms_ = dt;
   in_step_ = true;

@@ -269,7 +269,9 @@ void NeedleTissueContact::needle_forces(const Eigen::MatrixX3d& needle_x, const 
 }
 
 void NeedleTissueContact::end_step(std::vector<Vec3d>& particle_force) {
-  NEEDLE_REQUIRE(last_eval_ms_ >= step_start_ms_ + step_dt_ms_ * (1 - 1e-9), "contact: the step ended before the needle reached its end");
+  NEEDLE_REQUIRE(last_eval_ms_ >= step_start_ms_ + step_dt_ms_ - 1e-9 * std::max(step_dt_ms_, std::abs(step_start_ms_)),
+                 fmt::format("contact: the step ended at {} ms before the needle reached its end {} + {} ms", last_eval_ms_, step_start_ms_,
+                             step_dt_ms_));
   last_particle_forces(particle_force);
 }
 
