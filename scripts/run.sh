@@ -23,7 +23,12 @@ done
 ./build/bench/bench_mesh | tee out/bench_mesh.txt
 ./build/bench/bench_spg | tee out/bench_spg.txt
 ./build/bench/bench_needle | tee out/bench_needle.txt
+./build/bench/bench_insertion | tee out/bench_insertion.txt
+for preset in SB LMB; do  # the coupled paper insertion, about 15 minutes each on 2 cores
+  ./build/apps/needle run --preset "$preset" --out "out/run_$preset" --overwrite
+done
 echo "results in out/: <preset>.json (report), <preset>.stl, <preset>_half.glb, <preset>.png,"
 echo "  <preset>_half_t10.msh/.vtu + <preset>_mesh.json (T10 mesh and its report), tissue_particles.vtp/.json,"
 echo "  material_test.csv/.png/.json (the tissue card in uniaxial tension), stiffness_<preset>.json (tip compliance"
-echo "  and bending frequencies), sb_quick_run/ (a run folder: SB pushed through the cannula), bench_*.txt"
+echo "  and bending frequencies), sb_quick_run/ (a run folder: SB pushed through the cannula),"
+echo "  run_SB/, run_LMB/ (the coupled insertions: summary.json has deflection_mm), bench_*.txt"
