@@ -81,6 +81,8 @@ class InsertionOutput {
                              f.force_N.z());
     }
     facets_ << "\n";
+    history_.flush();  // a run killed from outside still leaves its history
+    facets_.flush();
   }
 
   void frame(const LspgInsertion& run) {
