@@ -87,14 +87,8 @@ class InsertionOutput {
 
   void frame(const LspgInsertion& run) {
     const int index = static_cast<int>(needle_frames_.size());
-    const NeedleDynamics& n = run.needle();
-    TetMesh deformed = n.needle().mesh();
-    deformed.X = n.positions_mm();
-    const ElementStresses stresses = n.needle().element_stresses(n.positions_mm());
     const std::string needle_name = fmt::format("frames/needle_{:04}.vtu", index);
-    write_vtu(folder_.path(needle_name).string(), deformed,
-              {{"von_mises_MPa", stresses.von_mises_MPa}, {"cauchy_stress_MPa", stresses.cauchy_MPa}},
-              {{"displacement_mm", n.displacements_mm()}, {"velocity_m_per_s", n.velocities_mm_per_ms()}});
+    write_needle_vtu(folder_.path(needle_name).string(), run.needle());
     needle_frames_.emplace_back(run.time_ms(), needle_name);
 
     const TissueParticles& p = run.tissue().particles();
@@ -167,18 +161,8 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
   log.line(fmt::format("tissue: {} particles at {} mm, {} bonds; set-up {:.2f} s", particles.num_particles(), scene.tissue.spacing_mm,
                        tissue.bonds().bonds.size(), setup_s));
 
-  NeedleSupports supports;
-  supports.driven = nodes_with_tag(needle.mesh(), "base");
-  if (needle.mesh().tag_index("symmetry") >= 0) supports.symmetry = nodes_with_tag(needle.mesh(), "symmetry");
-  supports.profile = scene.motion;
-  supports.direction = scene.direction;
-  NeedleDynamicsOptions dynamics;
-  dynamics.courant = scene.solver.courant;
-  dynamics.max_energy_error = scene.solver.max_energy_error;
-  dynamics.max_penetration_mm = scene.solver.max_penetration_mm;
-  dynamics.rigid = scene.needle.rigid;
-  NeedleDynamics needle_run(needle, supports, scene.cannula.enabled ? std::optional<CannulaOptions>(scene.cannula) : std::nullopt,
-                            dynamics);
+  NeedleDynamics needle_run(needle, driven_base_supports(needle.mesh(), scene.motion, scene.direction), scene.cannula.enabled ? std::optional<CannulaOptions>(scene.cannula) : std::nullopt,
+                            scene_dynamics_options(scene));
   LspgInsertion run(needle_run, tissue, surface, scene.tissue.contact, scene.solver.coupling);
   const int tip = nearest_node(needle.mesh(), built.tip_point);
   const double end_ms = scene.motion.end_time_ms();

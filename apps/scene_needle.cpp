@@ -4,6 +4,7 @@
 #include "apps/recipe_json.h"
 #include "geometry/grinding_recipe.h"
 #include "mesher/msh_file.h"
+#include "mesher/vtk_files.h"
 
 namespace needle {
 
@@ -33,6 +34,23 @@ SceneNeedle build_scene_needle(const NeedleScene& n) {
   out.tip_point = tip.tip_point;
   out.mesh_seconds = build.mesh_seconds;
   return out;
+}
+
+NeedleDynamicsOptions scene_dynamics_options(const Scene& scene) {
+  NeedleDynamicsOptions o;
+  o.courant = scene.solver.courant;
+  o.max_energy_error = scene.solver.max_energy_error;
+  o.max_penetration_mm = scene.solver.max_penetration_mm;
+  o.rigid = scene.needle.rigid;
+  return o;
+}
+
+void write_needle_vtu(const std::string& path, const NeedleDynamics& run) {
+  TetMesh deformed = run.needle().mesh();
+  deformed.X = run.positions_mm();
+  const ElementStresses stresses = run.needle().element_stresses(run.positions_mm());
+  write_vtu(path, deformed, {{"von_mises_MPa", stresses.von_mises_MPa}, {"cauchy_stress_MPa", stresses.cauchy_MPa}},
+            {{"displacement_mm", run.displacements_mm()}, {"velocity_m_per_s", run.velocities_mm_per_ms()}});
 }
 
 }  // namespace needle

@@ -1,11 +1,13 @@
 #pragma once
-// The needle a scene describes, meshed: from a preset, d_a, recipe, plain rod (through build_needle)
-// or a mesh file, with its tip point A. Shared by `needle simulate` and `needle run`.
+// The needle a scene describes: meshed from a preset, d_a, recipe, plain rod (through build_needle)
+// or a mesh file, with its tip point A; its dynamics options; its ParaView frames. Shared by
+// `needle simulate` and `needle run`.
 #include <Eigen/Dense>
 #include <string>
 
 #include "apps/scene.h"
 #include "mesher/tet_mesh.h"
+#include "solver/needle_dynamics.h"
 
 namespace needle {
 
@@ -17,5 +19,11 @@ struct SceneNeedle {
 };
 
 SceneNeedle build_scene_needle(const NeedleScene& needle);
+
+// The needle's step, stop criteria and rigidity from the scene's needle and solver sections.
+NeedleDynamicsOptions scene_dynamics_options(const Scene& scene);
+
+// The deformed needle as a .vtu: displacement and velocity (points), von Mises and Cauchy stress (tets).
+void write_needle_vtu(const std::string& path, const NeedleDynamics& run);
 
 }  // namespace needle

@@ -13,7 +13,6 @@
 #include "apps/scene.h"
 #include "apps/scene_needle.h"
 #include "geometry/input_error.h"
-#include "mesher/vtk_files.h"
 #include "solver/needle_dynamics.h"
 #include "solver/needle_stiffness.h"
 #include "solver/parallel.h"
@@ -32,13 +31,8 @@ struct SimulateOptions {
 };
 
 void write_frame(const RunFolder& folder, const NeedleDynamics& run, int index, std::vector<std::pair<double, std::string>>& frames) {
-  TetMesh deformed = run.needle().mesh();
-  deformed.X = run.positions_mm();
-  const ElementStresses stresses = run.needle().element_stresses(run.positions_mm());
   const std::string name = fmt::format("frames/needle_{:04}.vtu", index);
-  write_vtu(folder.path(name).string(), deformed,
-            {{"von_mises_MPa", stresses.von_mises_MPa}, {"cauchy_stress_MPa", stresses.cauchy_MPa}},
-            {{"displacement_mm", run.displacements_mm()}, {"velocity_m_per_s", run.velocities_mm_per_ms()}});
+  write_needle_vtu(folder.path(name).string(), run);
   frames.emplace_back(run.time_ms(), name);
 }
 
@@ -73,15 +67,8 @@ void run_simulation(const SimulateOptions& o) {
                        needle.stable_time_step_ms(), needle.unscaled_time_step_ms(), needle.physical_mass_g(),
                        100 * needle.added_mass_g() / needle.physical_mass_g(), needle.mass_scaled_elements()));
 
-  NeedleSupports supports;
-  supports.driven = nodes_with_tag(needle.mesh(), "base");
-  if (needle.mesh().tag_index("symmetry") >= 0) supports.symmetry = nodes_with_tag(needle.mesh(), "symmetry");
-  supports.profile = scene.motion;
-  supports.direction = scene.direction;
-  NeedleDynamicsOptions dynamics;
-  dynamics.courant = scene.solver.courant;
-  dynamics.max_energy_error = scene.solver.max_energy_error;
-  dynamics.max_penetration_mm = scene.solver.max_penetration_mm;
+  const NeedleSupports supports = driven_base_supports(needle.mesh(), scene.motion, scene.direction);
+  const NeedleDynamicsOptions dynamics = scene_dynamics_options(scene);
   NeedleDynamics run(needle, supports, scene.cannula.enabled ? std::optional<CannulaOptions>(scene.cannula) : std::nullopt, dynamics);
   const int tip = nearest_node(needle.mesh(), built.tip_point);
   const double end_ms = scene.motion.end_time_ms();

@@ -33,17 +33,15 @@ Result insert(const TetMesh& mesh, bool subcycling, double contact_courant, doub
   box.faces = {FaceCondition::free, FaceCondition::free, FaceCondition::fixed, FaceCondition::fixed, FaceCondition::symmetry,
                FaceCondition::fixed};
   SpgTissue tissue(make_particle_lattice(box, LatticeOptions{}), TissueMaterial{}, SpgOptions{});
-  NeedleSupports supports;
-  supports.driven = nodes_with_tag(needle.mesh(), "base");
-  supports.symmetry = nodes_with_tag(needle.mesh(), "symmetry");
-  supports.profile.accel_time_ms = 0.02;
-  supports.profile.travel_mm = 1.6;
-  NeedleDynamics dynamics(needle, supports, std::nullopt);
+  InsertionProfile profile;
+  profile.accel_time_ms = 0.02;
+  profile.travel_mm = 1.6;
+  NeedleDynamics dynamics(needle, driven_base_supports(needle.mesh(), profile), std::nullopt);
   CouplingOptions coupling;
   coupling.subcycling = subcycling;
   coupling.contact_courant = contact_courant;
   LspgInsertion run(dynamics, tissue, surface, ContactOptions{}, coupling);
-  const double end = supports.profile.end_time_ms();
+  const double end = profile.end_time_ms();
   while (run.time_ms() < end - 1e-12) run.step(end);
   const int tip = nearest_node(needle.mesh(), Eigen::Vector3d(0, -0.5, 0));
   Result r;

@@ -96,9 +96,8 @@ void LspgInsertion::step(double end_time_ms) {
   step_start_ms_ = t;
   step_dt_ms_ = dt;
   in_step_ = true;
-  StepReport report;
   try {
-    report = tissue_dynamics_.step(dt);  // the needle subcycles inside, at the contact evaluation
+    tissue_dynamics_.step(dt);  // the needle subcycles inside, at the contact evaluation
   } catch (...) {
     in_step_ = false;
     throw;
@@ -106,7 +105,6 @@ void LspgInsertion::step(double end_time_ms) {
   in_step_ = false;
   ++steps_;
   last_dt_ms_ = dt;
-  bonds_broken_ += report.bonds_broken_now;
   update_energy();
 
   max_inside_ = std::max(max_inside_, contact_.report().particles_inside);

@@ -71,7 +71,7 @@ class LspgInsertion {
   double max_energy_error() const { return max_energy_error_; }
   int max_particles_inside() const { return max_inside_; }
   double max_depth_mm() const { return max_depth_; }
-  long bonds_broken() const { return bonds_broken_; }
+  long bonds_broken() const { return static_cast<long>(tissue_.bonds().broken_count); }
   // Momenta (g mm/ms) and what the drive put in.
   Eigen::Vector3d tissue_momentum() const;
   Eigen::Vector3d needle_momentum() const { return needle_.momentum(); }
@@ -91,7 +91,7 @@ class LspgInsertion {
   bool in_step_ = false;
   double step_start_ms_ = 0, step_dt_ms_ = 0, last_dt_ms_ = 0, max_energy_error_ = 0, max_depth_ = 0;
   int max_inside_ = 0;
-  long steps_ = 0, bonds_broken_ = 0;
+  long steps_ = 0;
 };
 
 }  // namespace needle

@@ -16,6 +16,15 @@ double NeedleEnergy::balance_error() const {
   return std::abs(residual) / scale;
 }
 
+NeedleSupports driven_base_supports(const TetMesh& mesh, const InsertionProfile& profile, const Eigen::Vector3d& direction) {
+  NeedleSupports s;
+  s.driven = nodes_with_tag(mesh, "base");
+  if (mesh.tag_index("symmetry") >= 0) s.symmetry = nodes_with_tag(mesh, "symmetry");
+  s.profile = profile;
+  s.direction = direction;
+  return s;
+}
+
 NeedleDynamics::NeedleDynamics(const FeNeedle& needle, NeedleSupports supports, const std::optional<CannulaOptions>& cannula,
                                const NeedleDynamicsOptions& options)
     : needle_(needle), supports_(std::move(supports)), options_(options) {

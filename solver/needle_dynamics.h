@@ -28,6 +28,11 @@ struct NeedleSupports {
   Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
 };
 
+// The insertion's supports on a needle mesh: the `base` face driven by the profile along direction,
+// and the `symmetry` face (if the mesh is a half model) held at v_z = 0.
+NeedleSupports driven_base_supports(const TetMesh& mesh, const InsertionProfile& profile,
+                                    const Eigen::Vector3d& direction = Eigen::Vector3d::UnitX());
+
 struct NeedleDynamicsOptions {
   double courant = 0.9;                 // fraction of the stable step used
   double max_energy_error = 0.05;       // stop when the balance error exceeds this (after the first work)

@@ -181,8 +181,23 @@ void NeedleTissueContact::begin_step(const TissueParticles& particles, const Eig
       report_.max_depth_mm = std::max(report_.max_depth_mm, -p.phi);
     }
     if (!p.near) continue;
-    pairs_.push_back(p.pair);
-    pairs_.back().particle_velocity = particles.velocity_mm_per_ms[i];
+    Pair& pair = pairs_.emplace_back(p.pair);
+    pair.particle_velocity = particles.velocity_mm_per_ms[i];
+    // The law's constants over the step. The needle's mass at the contact point, by the force's weights,
+    // caps the stiffness on its side and enters the damper's reduced mass and the friction cap.
+    const Eigen::MatrixX3i& tri = surface_.triangles();
+    double needle_mass = std::numeric_limits<double>::infinity();
+    if (needle_mass_.size() > 0)
+      needle_mass = pair.triangle >= 0 ? pair.weights[0] * needle_mass_[tri(pair.triangle, 0)] + pair.weights[1] * needle_mass_[tri(pair.triangle, 1)] +
+                                             pair.weights[2] * needle_mass_[tri(pair.triangle, 2)]
+                                       : needle_mass_[pair.node];
+    const bool rigid = !std::isfinite(needle_dt_ms_);
+    pair.stiffness = rigid ? stiffness_[i]
+                           : std::min(stiffness_[i], options_.needle_stiffness_scale * needle_mass / (needle_dt_ms_ * needle_dt_ms_));
+    const double reduced_mass = std::isfinite(needle_mass) ? mass_[i] * needle_mass / (mass_[i] + needle_mass) : mass_[i];
+    pair.damping = options_.damping_ratio * 2 * std::sqrt(pair.stiffness * reduced_mass);
+    // The viscous cap: friction may not reverse the sliding within either body's step.
+    pair.friction_cap = 0.5 * std::min(mass_[i] / dt_ms, rigid ? mass_[i] / dt_ms : needle_mass / needle_dt_ms_);
   }
   pair_force_.assign(pairs_.size(), Eigen::Vector3d::Zero());
   step_start_ms_ = start_time_ms;
@@ -207,37 +222,17 @@ void NeedleTissueContact::needle_forces(const Eigen::MatrixX3d& needle_x, const 
     const Eigen::Vector3d surface_now = surface_point(pair, needle_x);
     const double gap = pair.gap_start - pair.normal.dot(tau * pair.particle_velocity - (surface_now - pair.surface_start));
     if (gap <= 0) continue;
-    const size_t s = static_cast<size_t>(pair.particle);
-    // The needle's mass at the contact point, by the same weights as the force.
-    double needle_mass = std::numeric_limits<double>::infinity();
-    if (needle_mass_.size() > 0)
-      needle_mass = pair.triangle >= 0 ? pair.weights[0] * needle_mass_[tri(pair.triangle, 0)] + pair.weights[1] * needle_mass_[tri(pair.triangle, 1)] +
-                                             pair.weights[2] * needle_mass_[tri(pair.triangle, 2)]
-                                       : needle_mass_[pair.node];
-    const double kn = std::isfinite(needle_dt_ms_)
-                          ? std::min(stiffness_[s], options_.needle_stiffness_scale * needle_mass / (needle_dt_ms_ * needle_dt_ms_))
-                          : stiffness_[s];
-    const double reduced_mass = std::isfinite(needle_mass) ? mass_[s] * needle_mass / (mass_[s] + needle_mass) : mass_[s];
-    Eigen::Vector3d needle_velocity;
-    if (pair.triangle >= 0)
-      needle_velocity = pair.weights[0] * needle_v.row(tri(pair.triangle, 0)).transpose() +
-                        pair.weights[1] * needle_v.row(tri(pair.triangle, 1)).transpose() +
-                        pair.weights[2] * needle_v.row(tri(pair.triangle, 2)).transpose();
-    else
-      needle_velocity = needle_v.row(pair.node).transpose();
-    const Eigen::Vector3d v_rel = pair.particle_velocity - needle_velocity;
+    const double kn = pair.stiffness;
+    const Eigen::Vector3d v_rel = pair.particle_velocity - surface_point(pair, needle_v);
     const double approach = v_rel.dot(pair.normal);  // > 0: separating
-    const double damping = options_.damping_ratio * 2 * std::sqrt(kn * reduced_mass);
-    const double fn = std::max(0.0, kn * gap - damping * approach);
+    const double fn = std::max(0.0, kn * gap - pair.damping * approach);
     friction_power -= (fn - kn * gap) * approach;  // the damper's share: -f_d . v_n >= 0
     f = fn * pair.normal;
     const Eigen::Vector3d v_t = v_rel - v_rel.dot(pair.normal) * pair.normal;
     const double speed = v_t.norm();
     double ft = 0;
     if (speed > 0 && mu > 0) {
-      // The viscous cap: friction may not reverse the sliding within either body's step.
-      const double cap = 0.5 * std::min(mass_[s] / step_dt_ms_, std::isfinite(needle_dt_ms_) ? needle_mass / needle_dt_ms_ : mass_[s] / step_dt_ms_);
-      ft = std::min(mu * fn, cap * speed);
+      ft = std::min(mu * fn, pair.friction_cap * speed);
       f -= ft * v_t / speed;
     }
     friction_power += ft * speed;

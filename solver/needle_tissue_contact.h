@@ -121,6 +121,7 @@ class NeedleTissueContact {
     Eigen::Vector3d particle_start = Eigen::Vector3d::Zero(), particle_velocity = Eigen::Vector3d::Zero();
     Eigen::Vector3d surface_start = Eigen::Vector3d::Zero();  // the needle's surface point at the start
     double gap_start = 0;                                      // skin - phi at the start
+    double stiffness = 0, damping = 0, friction_cap = 0;       // the law's constants over the step
   };
   struct Probe {  // one particle's geometric query
     bool near = false, inside = false;

@@ -41,17 +41,9 @@ struct Insertion {
       : needle(mesh, NeedleMaterial{}, mass_scaling_dt_ms),
         surface(needle.mesh()),
         tissue(particles, TissueMaterial{}, SpgOptions{}),
-        dynamics(needle, supports(needle, profile, direction), std::nullopt, options(rigid)),
+        dynamics(needle, driven_base_supports(needle.mesh(), profile, direction), std::nullopt, options(rigid)),
         run(dynamics, tissue, surface, contact, coupling) {}
 
-  static NeedleSupports supports(const FeNeedle& needle, const InsertionProfile& profile, const Eigen::Vector3d& direction) {
-    NeedleSupports s;
-    s.driven = nodes_with_tag(needle.mesh(), "base");
-    if (needle.mesh().tag_index("symmetry") >= 0) s.symmetry = nodes_with_tag(needle.mesh(), "symmetry");
-    s.profile = profile;
-    s.direction = direction;
-    return s;
-  }
   static NeedleDynamicsOptions options(bool rigid) {
     NeedleDynamicsOptions o;
     o.rigid = rigid;
