@@ -25,7 +25,11 @@ done
 ./build/bench/bench_needle | tee out/bench_needle.txt
 ./build/bench/bench_insertion | tee out/bench_insertion.txt
 for preset in SB LMB; do  # the coupled paper insertion, about 15 minutes each on 2 cores
-  ./build/apps/needle run --preset "$preset" --out "out/run_$preset" --overwrite
+  # Exit 3 is a run the solver stopped with a reason (summary.json says why; the folder is kept): a
+  # result to read, not a broken main job.
+  code=0
+  ./build/apps/needle run --preset "$preset" --out "out/run_$preset" --overwrite || code=$?
+  if [ "$code" -ne 0 ] && [ "$code" -ne 3 ]; then exit "$code"; fi
 done
 echo "results in out/: <preset>.json (report), <preset>.stl, <preset>_half.glb, <preset>.png,"
 echo "  <preset>_half_t10.msh/.vtu + <preset>_mesh.json (T10 mesh and its report), tissue_particles.vtp/.json,"
