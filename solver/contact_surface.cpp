@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
+#include <limits>
 #include <map>
 
 #include "geometry/input_error.h"
@@ -55,6 +56,17 @@ ContactSurface::ContactSurface(const TetMesh& mesh, const ContactSurfaceOptions&
     for (int k = 0; k < 3; ++k) nodes_.push_back(t[k]);
   std::sort(nodes_.begin(), nodes_.end());
   nodes_.erase(std::unique(nodes_.begin(), nodes_.end()), nodes_.end());
+  // Node -> incident triangles (CSR), for the pull-back.
+  node_triangle_start_.assign(static_cast<size_t>(mesh.X.rows() + 1), 0);
+  for (const auto& t : tris)
+    for (int k = 0; k < 3; ++k) ++node_triangle_start_[static_cast<size_t>(t[k] + 1)];
+  for (size_t n = 1; n < node_triangle_start_.size(); ++n) node_triangle_start_[n] += node_triangle_start_[n - 1];
+  node_triangles_.resize(static_cast<size_t>(node_triangle_start_.back()));
+  {
+    std::vector<int> fill(node_triangle_start_.begin(), node_triangle_start_.end() - 1);
+    for (size_t t = 0; t < tris.size(); ++t)
+      for (int k = 0; k < 3; ++k) node_triangles_[static_cast<size_t>(fill[static_cast<size_t>(tris[t][k])]++)] = static_cast<int>(t);
+  }
 
   // The closed reference surface for the level set: surface nodes, plus for a half model their mirror
   // images (nodes on the plane are their own image) and the mirrored triangles, reversed.
@@ -170,6 +182,34 @@ SurfacePoint ContactSurface::locate(const Eigen::Vector3d& p) const {
                              reference_.row(triangles_(t, 2)).transpose());
   best.distance_mm = std::sqrt(best_d2);
   return best;
+}
+
+Eigen::Vector3d ContactSurface::pull_back(const Eigen::Vector3d& p, int near_node, const Eigen::MatrixX3d& x) const {
+  const auto corner = [&](const Eigen::MatrixX3d& m, int t, int k) { return m.row(triangles_(t, k)).transpose().eval(); };
+  int best = -1;
+  double best_d2 = std::numeric_limits<double>::infinity();
+  Eigen::Vector3d best_c = Eigen::Vector3d::Zero();
+  for (int e = node_triangle_start_[static_cast<size_t>(near_node)]; e < node_triangle_start_[static_cast<size_t>(near_node) + 1]; ++e) {
+    const int t = node_triangles_[static_cast<size_t>(e)];
+    const Eigen::Vector3d c = closest_point_on_triangle(p, corner(x, t, 0), corner(x, t, 1), corner(x, t, 2));
+    const double d2 = (p - c).squaredNorm();
+    if (d2 < best_d2) best_d2 = d2, best = t, best_c = c;
+  }
+  if (best < 0) return p - (x.row(near_node) - reference_.row(near_node)).transpose();  // a node on no triangle
+  const Eigen::Vector3d a = corner(x, best, 0), b = corner(x, best, 1), c = corner(x, best, 2);
+  // Barycentric weights of the closest point on the current triangle.
+  const Eigen::Vector3d ab = b - a, ac = c - a, ap = best_c - a;
+  const double d00 = ab.dot(ab), d01 = ab.dot(ac), d11 = ac.dot(ac), d20 = ap.dot(ab), d21 = ap.dot(ac);
+  const double denominator = d00 * d11 - d01 * d01;
+  if (!(denominator > 0)) return p - (x.row(near_node) - reference_.row(near_node)).transpose();
+  const double v = (d11 * d20 - d01 * d21) / denominator, w = (d00 * d21 - d01 * d20) / denominator;
+  const Eigen::Vector3d A = corner(reference_, best, 0), B = corner(reference_, best, 1), C = corner(reference_, best, 2);
+  const Eigen::Vector3d on_reference = (1 - v - w) * A + v * B + w * C;
+  // The offset from the surface, turned with the triangle.
+  const Eigen::Vector3d n_cur = ab.cross(ac).normalized(), n_ref = (B - A).cross(C - A).normalized();
+  const Eigen::Vector3d offset = p - best_c;
+  if (!n_cur.allFinite() || !n_ref.allFinite()) return on_reference + offset;
+  return on_reference + Eigen::Quaterniond::FromTwoVectors(n_cur, n_ref) * offset;
 }
 
 }  // namespace needle

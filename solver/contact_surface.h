@@ -10,10 +10,8 @@
 //    deep inside still gets a distance and a normal.
 //  - A uniform grid of the reference triangles, to find the triangle under a reference point.
 //
-// The level set lives in the reference configuration; a current point p is pulled back by the
-// displacement u of the nearest surface node, X = p - u. The error of that pull-back is the local
-// rotation times the distance to that node (about 0.06 rad x 0.2 mm = 0.01 mm at the paper's largest
-// tip slope), below the level set's own half-voxel error at the default voxel.
+// The level set lives in the reference configuration; a current point p is pulled back through the
+// current triangle closest to it (pull_back), exact for the linear triangles up to their own rotation.
 #include <Eigen/Dense>
 #include <optional>
 #include <string>
@@ -56,6 +54,13 @@ class ContactSurface {
   // triangle -1 if there is none that close.
   SurfacePoint locate(const Eigen::Vector3d& reference_point) const;
 
+  // A current point p pulled back to the reference configuration: the closest point on the current
+  // triangles around the surface node nearest p (its one ring), carried to the reference triangle by its
+  // barycentric weights, plus the offset p - closest point turned with that triangle. Continuous where
+  // the nearest node changes (unlike X = p - u_node, whose jump is the local rotation times a node
+  // spacing: 0.07 mm in a bent 0.4 mm mesh, more than the contact's skin).
+  Eigen::Vector3d pull_back(const Eigen::Vector3d& p, int near_node, const Eigen::MatrixX3d& current) const;
+
  private:
   Eigen::MatrixX3i triangles_;
   std::vector<int> tag_;
@@ -70,6 +75,7 @@ class ContactSurface {
   Eigen::Vector3i grid_cells_;
   double grid_cell_mm_ = 0;
   std::vector<int> cell_start_, cell_triangles_;
+  std::vector<int> node_triangle_start_, node_triangles_;  // node -> incident triangles (CSR)
 };
 
 }  // namespace needle

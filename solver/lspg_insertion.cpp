@@ -80,6 +80,7 @@ void LspgInsertion::update_energy() {
   energy_.contact_work_mJ = n.external_work_mJ + t.external_work_mJ;
   energy_.penalty_energy_mJ = contact_.report().penalty_energy_mJ;
   energy_.friction_dissipation_mJ = contact_.friction_dissipation_mJ();
+  energy_.relinearisation_energy_mJ = contact_.relinearisation_energy_mJ();
 }
 
 void LspgInsertion::step(double end_time_ms) {

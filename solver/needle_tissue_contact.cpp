@@ -103,8 +103,7 @@ void NeedleTissueContact::probe(const std::vector<Vec3d>& x, const Eigen::Matrix
       if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) continue;
       const int node = nearest_surface_node(p, needle_x);
       if (node < 0) continue;
-      // Pull back to the reference configuration with the nearest surface node's displacement.
-      const Eigen::Vector3d X = p - (needle_x.row(node) - X0.row(node)).transpose();
+      const Eigen::Vector3d X = surface_.pull_back(p, node, needle_x);
       const double phi = level_set.signed_distance_mm(X);
       probe.phi = phi;
       probe.inside = phi < 0;
@@ -199,7 +198,14 @@ void NeedleTissueContact::begin_step(const TissueParticles& particles, const Eig
     // The viscous cap: friction may not reverse the sliding within either body's step.
     pair.friction_cap = 0.5 * std::min(mass_[i] / dt_ms, rigid ? mass_[i] / dt_ms : needle_mass / needle_dt_ms_);
   }
+  // The penalty energy jumps where the geometry is found anew (the gap was linearised over the last step).
+  double penalty_now = 0;
+  for (const Pair& pair : pairs_)
+    if (pair.gap_start > 0) penalty_now += 0.5 * pair.stiffness * pair.gap_start * pair.gap_start;
+  if (start_time_ms > 0) relinearisation_energy_mJ_ += penalty_now - report_.penalty_energy_mJ;
   pair_force_.assign(pairs_.size(), Eigen::Vector3d::Zero());
+  pair_elastic_force_.assign(pairs_.size(), Eigen::Vector3d::Zero());
+  pair_dissipative_impulse_.assign(pairs_.size(), Eigen::Vector3d::Zero());
   step_start_ms_ = start_time_ms;
   step_dt_ms_ = dt_ms;
   last_eval_ms_ = std::max(last_eval_ms_, start_time_ms);
@@ -218,7 +224,9 @@ void NeedleTissueContact::needle_forces(const Eigen::MatrixX3d& needle_x, const 
   for (size_t k = 0; k < pairs_.size(); ++k) {
     const Pair& pair = pairs_[k];
     Eigen::Vector3d& f = pair_force_[k];
+    Eigen::Vector3d& f_elastic = pair_elastic_force_[k];
     f.setZero();
+    f_elastic.setZero();
     const Eigen::Vector3d surface_now = surface_point(pair, needle_x);
     const double gap = pair.gap_start - pair.normal.dot(tau * pair.particle_velocity - (surface_now - pair.surface_start));
     if (gap <= 0) continue;
@@ -228,6 +236,7 @@ void NeedleTissueContact::needle_forces(const Eigen::MatrixX3d& needle_x, const 
     const double fn = std::max(0.0, kn * gap - pair.damping * approach);
     friction_power -= (fn - kn * gap) * approach;  // the damper's share: -f_d . v_n >= 0
     f = fn * pair.normal;
+    f_elastic = kn * gap * pair.normal;
     const Eigen::Vector3d v_t = v_rel - v_rel.dot(pair.normal) * pair.normal;
     const double speed = v_t.norm();
     double ft = 0;
@@ -236,6 +245,8 @@ void NeedleTissueContact::needle_forces(const Eigen::MatrixX3d& needle_x, const 
       f -= ft * v_t / speed;
     }
     friction_power += ft * speed;
+    // The dissipative part (damper and friction) as the needle receives it over its substep.
+    if (dt > 0) pair_dissipative_impulse_[k] += dt * (f - f_elastic);
     if (pair.triangle >= 0) {
       for (int c = 0; c < 3; ++c) out.emplace_back(tri(pair.triangle, c), -pair.weights[c] * f);
       FacetContact& facet = report_.facets[static_cast<size_t>(surface_.triangle_tag(pair.triangle))];
@@ -252,13 +263,18 @@ void NeedleTissueContact::needle_forces(const Eigen::MatrixX3d& needle_x, const 
   }
   report_.friction_power_mW = friction_power;
   if (dt > 0) friction_dissipation_mJ_ += 0.5 * dt * (last_friction_power_mW_ + friction_power);
-  previous_force_.clear();
-  previous_particles_.clear();
+  contacts_.clear();
   for (size_t k = 0; k < pairs_.size(); ++k)
-    if (pair_force_[k].squaredNorm() > 0) {
-      previous_force_.push_back(pair_force_[k]);
-      previous_particles_.push_back(pairs_[k].particle);
-    }
+    if (pair_force_[k].squaredNorm() > 0) contacts_.emplace_back(pairs_[k].particle, pairs_[k].triangle);
+  if (tau == 0) {  // the state at a step's start (t = 0, before any step): the particles get the forces as they are
+    previous_force_.clear();
+    previous_particles_.clear();
+    for (size_t k = 0; k < pairs_.size(); ++k)
+      if (pair_force_[k].squaredNorm() > 0) {
+        previous_force_.push_back(pair_force_[k]);
+        previous_particles_.push_back(pairs_[k].particle);
+      }
+  }
   last_friction_power_mW_ = friction_power;
   last_eval_ms_ = time_ms;
 }
@@ -267,6 +283,17 @@ void NeedleTissueContact::end_step(std::vector<Vec3d>& particle_force) {
   NEEDLE_REQUIRE(last_eval_ms_ >= step_start_ms_ + step_dt_ms_ - 1e-9 * std::max(step_dt_ms_, std::abs(step_start_ms_)),
                  fmt::format("contact: the step ended at {} ms before the needle reached its end {} + {} ms", last_eval_ms_, step_start_ms_,
                              step_dt_ms_));
+  // The particles get the penalty at the step's end and the dissipative forces as the needle received
+  // them over the step (their mean): friction follows the needle's vibration within the step, which one
+  // sample at the end would alias. The elastic part must not lag (see the header); the dissipative part may.
+  previous_force_.clear();
+  previous_particles_.clear();
+  for (size_t k = 0; k < pairs_.size(); ++k) {
+    const Eigen::Vector3d f = pair_elastic_force_[k] + pair_dissipative_impulse_[k] / step_dt_ms_;
+    if (f.squaredNorm() == 0) continue;
+    previous_force_.push_back(f);
+    previous_particles_.push_back(pairs_[k].particle);
+  }
   last_particle_forces(particle_force);
 }
 
@@ -277,8 +304,23 @@ void NeedleTissueContact::last_particle_forces(std::vector<Vec3d>& particle_forc
 
 std::vector<std::uint8_t> NeedleTissueContact::in_contact() const {
   std::vector<std::uint8_t> flags(stiffness_.size(), 0);
-  for (int p : previous_particles_) flags[static_cast<size_t>(p)] = 1;
+  for (const auto& [p, triangle] : contacts_) flags[static_cast<size_t>(p)] = 1;
   return flags;
+}
+
+std::vector<Eigen::Vector3d> NeedleTissueContact::pull_back(const std::vector<Vec3d>& x, const Eigen::MatrixX3d& needle_x) {
+  build_node_grid(needle_x);
+  std::vector<Eigen::Vector3d> out(x.size(), Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()));
+  parallel_for(static_cast<std::int64_t>(x.size()), [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t i = begin; i < end; ++i) {
+      const size_t s = static_cast<size_t>(i);
+      const Eigen::Vector3d p = x[s];
+      if ((p.array() < box_lo_.array() - node_cell_mm_).any() || (p.array() > box_hi_.array() + node_cell_mm_).any()) continue;
+      const int node = nearest_surface_node(p, needle_x);
+      if (node >= 0) out[s] = surface_.pull_back(p, node, needle_x);
+    }
+  });
+  return out;
 }
 
 }  // namespace needle

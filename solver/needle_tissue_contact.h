@@ -2,7 +2,7 @@
 // Frictional penalty contact between the needle's surface and the tissue particles, integrated at the
 // needle's (fine) step inside the tissue's (coarse) step.
 //
-// Contact law, for a particle at p pulled back to the needle's reference configuration X = p - u
+// Contact law, for a particle at p pulled back to the needle's reference configuration X (ContactSurface::pull_back)
 // (contact_surface.h), with signed distance phi(X) to the needle surface:
 //   gap g = skin - phi > 0 means contact (the skin keeps particles off the true surface);
 //   normal   f_n = k_i g n,   k_i = stiffness_factor * M * V_i / h_i^2  (M the tissue's P-wave modulus,
@@ -102,6 +102,9 @@ class NeedleTissueContact {
   const ContactReport& report() const { return report_; }
   // Energy dissipated by friction and normal damping since the start.
   double friction_dissipation_mJ() const { return friction_dissipation_mJ_; }
+  // Sum of the penalty energy's jumps where each step finds the geometry anew (the gap is linearised
+  // within a step): energy the contact's discretisation adds (> 0) or removes. A diagnostic.
+  double relinearisation_energy_mJ() const { return relinearisation_energy_mJ_; }
   // Classifies every particle against the needle at the given state (level set; no forces).
   InsideReport classify(const TissueParticles& particles, const Eigen::MatrixX3d& needle_x_mm);
 
@@ -109,6 +112,11 @@ class NeedleTissueContact {
   double stable_time_step_ms() const { return stable_dt_ms_; }
   // Per particle: 1 if in contact at the last evaluation.
   std::vector<std::uint8_t> in_contact() const;
+  // The contacts of the last evaluation: particle and surface triangle (-1: a node fallback).
+  const std::vector<std::pair<int, int>>& contacts() const { return contacts_; }
+  // Points pulled back to the needle's reference configuration by the displacement of the nearest
+  // surface node (as the contact does); NaN where no surface node lies within the search radius.
+  std::vector<Eigen::Vector3d> pull_back(const std::vector<Vec3d>& x, const Eigen::MatrixX3d& needle_x);
   const ContactSurface& surface() const { return surface_; }
   const ContactOptions& options() const { return options_; }
 
@@ -143,9 +151,12 @@ class NeedleTissueContact {
   std::vector<Probe> probes_;
   std::vector<Pair> pairs_;
   std::vector<Eigen::Vector3d> pair_force_;                   // per pair, at the current evaluation
-  std::vector<Eigen::Vector3d> previous_force_;               // the last evaluation's non-zero forces ...
+  std::vector<Eigen::Vector3d> pair_elastic_force_;           // per pair, the penalty part of pair_force_
+  std::vector<Eigen::Vector3d> pair_dissipative_impulse_;     // per pair, damper + friction integrated over the step
+  std::vector<Eigen::Vector3d> previous_force_;               // the particles' forces of the last step's end ...
   std::vector<int> previous_particles_;                       // ... and their particles
-  double step_start_ms_ = 0, step_dt_ms_ = 0, last_eval_ms_ = 0, last_friction_power_mW_ = 0, friction_dissipation_mJ_ = 0;
+  std::vector<std::pair<int, int>> contacts_;                 // (particle, triangle) in contact at the last evaluation
+  double step_start_ms_ = 0, step_dt_ms_ = 0, last_eval_ms_ = 0, last_friction_power_mW_ = 0, friction_dissipation_mJ_ = 0, relinearisation_energy_mJ_ = 0;
   ContactReport report_;
   // Grid of the current surface nodes (rebuilt per query): sorted (cell, node).
   double node_cell_mm_ = 0;
