@@ -113,7 +113,8 @@ void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc) {
     t.spg.stabilization_coefficient = g.number("stabilization_coefficient", t.spg.stabilization_coefficient, within(0.0, 10.0));
     t.spg.smoothing_interval_steps = g.integer("smoothing_interval_steps", t.spg.smoothing_interval_steps, 1, 1000000);
     t.spg.bond_failure.enabled = g.boolean("bond_failure", t.spg.bond_failure.enabled);
-    t.spg.bond_failure.plastic_strain = g.number("failure_plastic_strain", t.spg.bond_failure.plastic_strain, positive());
+    t.spg.bond_failure.measure = name("failure_measure", failure_measure_name(t.spg.bond_failure.measure), failure_measure_from_name);
+    t.spg.bond_failure.strain = g.number("failure_strain", t.spg.bond_failure.strain, positive());
     t.spg.bond_failure.stretch_ratio = g.number("failure_stretch_ratio", t.spg.bond_failure.stretch_ratio, non_negative());
     t.spg.cfl = g.number("cfl", t.spg.cfl, within(1e-3, 1.0));
     g.finish();
@@ -201,7 +202,8 @@ json scene_to_json(const Scene& s) {
                {"stabilization_coefficient", t.spg.stabilization_coefficient},
                {"smoothing_interval_steps", t.spg.smoothing_interval_steps},
                {"bond_failure", t.spg.bond_failure.enabled},
-               {"failure_plastic_strain", t.spg.bond_failure.plastic_strain},
+               {"failure_measure", failure_measure_name(t.spg.bond_failure.measure)},
+               {"failure_strain", t.spg.bond_failure.strain},
                {"failure_stretch_ratio", t.spg.bond_failure.stretch_ratio},
                {"cfl", t.spg.cfl}}},
       {"contact", {{"stiffness_factor", t.contact.stiffness_factor}, {"skin_mm", t.contact.skin_mm}, {"voxel_mm", t.contact.voxel_mm},

@@ -16,8 +16,8 @@ void SpgOptions::validate() const {
   NEEDLE_REQUIRE(stabilization != Stabilization::filter || stabilization_coefficient <= 1.0,
                  "SPG filter coefficient must lie in [0, 1]");
   NEEDLE_REQUIRE(smoothing_interval_steps >= 1, "SPG smoothing_interval_steps must be >= 1");
-  NEEDLE_REQUIRE(std::isfinite(bond_failure.plastic_strain) && bond_failure.plastic_strain > 0,
-                 fmt::format("bond failure plastic strain must be positive (got {})", bond_failure.plastic_strain));
+  NEEDLE_REQUIRE(std::isfinite(bond_failure.strain) && bond_failure.strain > 0,
+                 fmt::format("bond failure strain must be positive (got {})", bond_failure.strain));
   NEEDLE_REQUIRE(std::isfinite(bond_failure.stretch_ratio) && (bond_failure.stretch_ratio == 0 || bond_failure.stretch_ratio > 1),
                  fmt::format("bond failure stretch ratio must be 0 (off) or > 1 (got {})", bond_failure.stretch_ratio));
   NEEDLE_REQUIRE(std::isfinite(cfl) && cfl > 0 && cfl <= 1.0, fmt::format("CFL number must lie in (0, 1] (got {})", cfl));
@@ -29,6 +29,13 @@ KernelUpdate kernel_update_from_name(const std::string& name) {
   throw InputError(fmt::format("kernel update '{}' is not one of lagrangian, reinitialized", name));
 }
 std::string kernel_update_name(KernelUpdate k) { return k == KernelUpdate::lagrangian ? "lagrangian" : "reinitialized"; }
+
+FailureMeasure failure_measure_from_name(const std::string& name) {
+  if (name == "effective" || name == "effective_strain") return FailureMeasure::effective_strain;
+  if (name == "plastic" || name == "plastic_strain") return FailureMeasure::plastic_strain;
+  throw InputError(fmt::format("bond failure measure '{}' is not one of effective, plastic", name));
+}
+std::string failure_measure_name(FailureMeasure m) { return m == FailureMeasure::plastic_strain ? "plastic" : "effective"; }
 
 Stabilization stabilization_from_name(const std::string& name) {
   if (name == "none") return Stabilization::none;

@@ -2,6 +2,8 @@
 // The numerical choices of the SPG tissue, each a parameter whose error is measured (docs/solver.md).
 #include <string>
 
+#include <string>
+
 namespace needle {
 
 // How the kernel follows the material: `lagrangian` keeps the reference supports (total Lagrangian);
@@ -19,8 +21,22 @@ enum class KernelUpdate { lagrangian, reinitialized };
 //  - none:    plain nodal integration (shows the spurious modes; for tests).
 enum class Stabilization { none, penalty, filter };
 
+// Which particle strain the bond criterion averages over a pair:
+//  - effective_strain: eps_p + the equivalent elastic log strain (the total effective strain; the paper:
+//    "two adjacent SPG particles separate when the average effective tensile strain exceeds 1.84", the
+//    rupture strain of its tensile test). A bond also fails when its own log stretch ln(l / L) exceeds
+//    the same strain: the elastic part unloads when a crack opens, and a bond at the edge of a support
+//    carries too little to keep its particles strained, so without this a cut never fully separates;
+//  - plastic_strain: eps_p alone (LS-DYNA's SPG FS). With this card's large yield strain (1.44 at
+//    E = 0.665 MPa) a bond would need ~3.3 total strain: in the insertion nothing breaks.
+enum class FailureMeasure { effective_strain, plastic_strain };
+
+FailureMeasure failure_measure_from_name(const std::string& name);  // "effective", "plastic"
+std::string failure_measure_name(FailureMeasure m);
+
 struct BondFailure {
-  double plastic_strain = 1.84;  // a bond breaks when the pair's mean effective plastic strain exceeds this
+  FailureMeasure measure = FailureMeasure::effective_strain;
+  double strain = 1.84;          // a bond breaks when the pair's mean strain (of `measure`) exceeds this
   double stretch_ratio = 0.0;    // and/or when current / reference length exceeds this (0: off)
   bool enabled = true;
 };

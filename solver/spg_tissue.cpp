@@ -69,6 +69,7 @@ SpgTissue::SpgTissue(const ParticleSet& set, const TissueMaterial& material, con
   p_.stress_MPa.assign(static_cast<size_t>(n), Mat3d::Zero());
   p_.elastic_left_cauchy_green.assign(static_cast<size_t>(n), Mat3d::Identity());
   p_.plastic_strain.assign(static_cast<size_t>(n), 0.0);
+  p_.effective_strain.assign(static_cast<size_t>(n), 0.0);
   p_.defect_mm.assign(static_cast<size_t>(n), 0.0);
   defect_.assign(static_cast<size_t>(n), Vec3d::Zero());
   piola_volume_.assign(static_cast<size_t>(n), Mat3d::Zero());
@@ -134,6 +135,7 @@ ForceReport SpgTissue::compute_forces(double dt_ms) {
         piola_volume_[s].setZero();
         p_.stress_MPa[s].setZero();
         p_.elastic_left_cauchy_green[s].setIdentity();
+        p_.effective_strain[s] = p_.plastic_strain[s];
         continue;
       }
       const Mat3d F = gather_gradient(rk_, i, p_.position_mm);
@@ -152,6 +154,7 @@ ForceReport SpgTissue::compute_forces(double dt_ms) {
         piola_volume_[s].setZero();
         p_.stress_MPa[s].setZero();
         p_.elastic_left_cauchy_green[s].setIdentity();
+        p_.effective_strain[s] = p_.plastic_strain[s];
         continue;
       }
       if (dt_ms > 0) {
@@ -160,6 +163,7 @@ ForceReport SpgTissue::compute_forces(double dt_ms) {
         p_.stress_MPa[s] = u.cauchy_stress_MPa;
         p_.elastic_left_cauchy_green[s] = u.state.elastic_left_cauchy_green;
         p_.plastic_strain[s] = u.state.plastic_strain;
+        p_.effective_strain[s] = u.effective_strain;
         if (u.rate_factor_capped) status[s] = kCapped;
       }
       p_.deformation_gradient[s] = F;
@@ -213,7 +217,22 @@ std::int64_t SpgTissue::break_bonds() {
       const Bond& bond = bonds_.bonds[static_cast<size_t>(b)];
       if (bond.broken) continue;
       const size_t i = static_cast<size_t>(bond.i), j = static_cast<size_t>(bond.j);
-      bool fails = 0.5 * (p_.plastic_strain[i] + p_.plastic_strain[j]) > rule.plastic_strain;
+      // A bond that no integration point uses any more (its entries only in the rows of detached particles)
+      // couples nothing: it is separated whatever the strains say (a detached particle's strain is frozen).
+      const bool dead = !(bond.entry_ij >= 0 && rk_.valid[i]) && !(bond.entry_ji >= 0 && rk_.valid[j]);
+      if (dead) {
+        breaking[static_cast<size_t>(b)] = 2;
+        continue;
+      }
+      const std::vector<double>& strain = rule.measure == FailureMeasure::plastic_strain ? p_.plastic_strain : p_.effective_strain;
+      bool fails = 0.5 * (strain[i] + strain[j]) > rule.strain;
+      if (rule.measure == FailureMeasure::effective_strain && !fails) {
+        // The bond's own log stretch against the same rupture strain: the long, weak bonds at the corner of
+        // a support carry almost nothing, so a crack opening past them never raises the particles'
+        // strain; measured along the bond they fail with the material around them.
+        const double reference = (p_.reference_mm[i] - p_.reference_mm[j]).norm();
+        fails = (p_.position_mm[i] - p_.position_mm[j]).norm() > std::exp(rule.strain) * reference;
+      }
       if (rule.stretch_ratio > 0) {
         const double reference = (p_.reference_mm[i] - p_.reference_mm[j]).norm();
         fails = fails || (p_.position_mm[i] - p_.position_mm[j]).norm() > rule.stretch_ratio * reference;
@@ -228,10 +247,13 @@ std::int64_t SpgTissue::break_bonds() {
     bond.broken = true;
     if (bond.entry_ij >= 0) rk_.cut[static_cast<size_t>(bond.entry_ij)] = 1;
     if (bond.entry_ji >= 0) rk_.cut[static_cast<size_t>(bond.entry_ji)] = 1;
+    if (breaking[b] == 2) continue;  // dead: no row of a live integration point changes
     rows.push_back(bond.i);
     rows.push_back(bond.j);
   }
-  if (rows.empty()) return 0;
+  const std::int64_t count = static_cast<std::int64_t>(breaking.size()) - std::count(breaking.begin(), breaking.end(), std::uint8_t{0});
+  bonds_.broken_count += count;
+  if (rows.empty()) return count;
   std::sort(rows.begin(), rows.end());
   rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
   const Eigen::Map<const Eigen::VectorXd> radius(p_.support_radius_mm.data(), p_.size());
@@ -247,8 +269,6 @@ std::int64_t SpgTissue::break_bonds() {
       p_.elastic_left_cauchy_green[s].setIdentity();
     }
   }
-  const std::int64_t count = static_cast<std::int64_t>(std::count(breaking.begin(), breaking.end(), std::uint8_t{1}));
-  bonds_.broken_count += count;
   return count;
 }
 

@@ -38,6 +38,7 @@ struct TissueParticles {
   std::vector<Mat3d> stress_MPa;            // Cauchy
   std::vector<Mat3d> elastic_left_cauchy_green;  // b_e of the material (see tissue_material.h)
   std::vector<double> plastic_strain;
+  std::vector<double> effective_strain;   // eps_p + equivalent elastic log strain (StressUpdate)
   std::vector<double> defect_mm;          // |g_i|, the smoothing defect (zero-energy-mode indicator)
   std::int64_t size() const { return static_cast<std::int64_t>(position_mm.size()); }
 };

@@ -115,6 +115,8 @@ StressUpdate update_stress(const TissueMaterial& m, const MaterialPoint& state, 
   out.state.plastic_strain = eps_p;
   out.cauchy_stress_MPa = V * sigma_principal.asDiagonal() * V.transpose();
   out.rate_factor_capped = capped;
+  const Eigen::Vector3d h_dev_final = h.array() - h.mean();
+  out.effective_strain = eps_p + std::sqrt(2.0 / 3.0 * h_dev_final.squaredNorm());
   (void)I;
   return out;
 }

@@ -64,6 +64,11 @@ struct StressUpdate {
   MaterialPoint state;
   Eigen::Matrix3d cauchy_stress_MPa;
   bool rate_factor_capped;
+  // Total effective strain: eps_p + the von Mises equivalent of the elastic log strain,
+  // sqrt(2/3 dev(h):dev(h)). In uniaxial tension of the plastically incompressible card this is the
+  // true strain of the tensile test (up to the elastic part's compressibility), the measure in which
+  // the paper gives its rupture strain (1.84).
+  double effective_strain;
 };
 
 // One increment with relative deformation gradient f = F_n+1 F_n^-1 over dt_ms (> 0 gives the strain
