@@ -9,6 +9,7 @@
 #include "geometry/input_error.h"
 #include "mesher/particle_lattice.h"
 #include "mesher/vtk_files.h"
+#include "solver/groove_fill.h"
 #include "solver/lspg_insertion.h"
 #include "solver/parallel.h"
 #include "solver/solver_error.h"
@@ -42,6 +43,27 @@ Eigen::VectorXd broken_bonds(const SpgTissue& tissue) {
   return count;
 }
 
+// The groove fill of the run's current state (groove_fill.h); empty without a groove.
+GrooveFill run_groove_fill(LspgInsertion& run, const SceneNeedle& needle, const Scene& scene) {
+  if (!needle.groove) return {};
+  const TissueParticles& p = run.tissue().particles();
+  NeedleTissueContact& contact = run.contact_model();
+  GrooveFillInput in;
+  in.groove = *needle.groove;
+  in.radius_mm = needle.radius_mm;
+  const double drive_x = run.needle().drive_displacement_mm().x();
+  in.tissue_min_x_mm = scene.tissue.entry_x_mm - drive_x;
+  in.tissue_max_x_mm = scene.tissue.entry_x_mm + scene.tissue.size_mm.x() - drive_x;
+  in.reference_points = contact.pull_back(p.position_mm, run.needle().positions_mm());
+  in.spacing_mm = p.spacing_mm;
+  in.touches_floor.assign(in.reference_points.size(), 0);
+  const ContactSurface& surface = contact.surface();
+  for (const auto& [particle, triangle] : contact.contacts())
+    if (triangle >= 0 && surface.tag_names()[static_cast<size_t>(surface.triangle_tag(triangle))] == "groove_floor")
+      in.touches_floor[static_cast<size_t>(particle)] = 1;
+  return measure_groove_fill(in);
+}
+
 class InsertionOutput {
  public:
   InsertionOutput(const RunFolder& folder, const ContactSurface& surface) : folder_(folder), surface_(surface) {
@@ -49,8 +71,8 @@ class InsertionOutput {
     history_ << "time_ms,insertion_mm,tip_dx_mm,tip_dy_mm,tip_dz_mm,deflection_mm,drive_force_x_N,drive_force_y_N,drive_force_z_N,"
                 "contact_force_x_N,contact_force_y_N,contact_force_z_N,particles_in_contact,particles_inside,max_depth_mm,"
                 "bonds_broken,tissue_kinetic_mJ,tissue_internal_mJ,needle_kinetic_mJ,needle_strain_mJ,drive_work_mJ,"
-                "cannula_work_mJ,contact_work_mJ,penalty_energy_mJ,friction_dissipation_mJ,energy_balance_error,"
-                "coupling_step_ms,needle_steps\n";
+                "cannula_work_mJ,contact_work_mJ,penalty_energy_mJ,friction_dissipation_mJ,relinearisation_energy_mJ,energy_balance_error,"
+                "coupling_step_ms,needle_steps,groove_fill,groove_floor_contact_fraction\n";
     facets_.open(folder.path("facet_forces.csv"));
     facets_ << "time_ms,insertion_mm";
     for (const std::string& tag : surface.tag_names())
@@ -59,7 +81,7 @@ class InsertionOutput {
     facets_ << "\n";
   }
 
-  void record(const LspgInsertion& run, int tip) {
+  void record(const LspgInsertion& run, int tip, const GrooveFill& groove) {
     const NeedleDynamics& n = run.needle();
     const Eigen::RowVector3d u = n.positions_mm().row(tip) - n.needle().mesh().X.row(tip);
     const Eigen::Vector3d drive = n.drive_displacement_mm(), reaction = n.drive_reaction_N();
@@ -67,12 +89,12 @@ class InsertionOutput {
     const InsertionEnergy& e = run.energy();
     history_ << fmt::format(
         "{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{},{},{:.6g},{},{:.9g},{:.9g},{:.9g},{:.9g},"
-        "{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.6g},{:.6g},{}\n",
+        "{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.6g},{:.6g},{},{:.4f},{:.4f}\n",
         run.time_ms(), drive.norm(), u.x(), u.y(), u.z(), u.y() - drive.y(), reaction.x(), reaction.y(), reaction.z(),
         c.force_on_needle_N.x(), c.force_on_needle_N.y(), c.force_on_needle_N.z(), c.particles_in_contact, c.particles_inside,
         c.max_depth_mm, run.bonds_broken(), e.tissue_kinetic_mJ, e.tissue_internal_mJ, e.needle_kinetic_mJ, e.needle_strain_mJ,
-        e.drive_work_mJ, e.cannula_work_mJ, e.contact_work_mJ, e.penalty_energy_mJ, e.friction_dissipation_mJ, e.balance_error(),
-        run.last_step_ms(), run.needle_steps());
+        e.drive_work_mJ, e.cannula_work_mJ, e.contact_work_mJ, e.penalty_energy_mJ, e.friction_dissipation_mJ, e.relinearisation_energy_mJ, e.balance_error(),
+        run.last_step_ms(), run.needle_steps(), groove.groove_fill, groove.floor_contact_fraction);
     facets_ << fmt::format("{:.9g},{:.9g}", run.time_ms(), drive.norm());
     for (size_t k = 0; k < surface_.tag_names().size(); ++k) {
       if (surface_.tag_names()[k] == "symmetry") continue;
@@ -94,7 +116,7 @@ class InsertionOutput {
     const TissueParticles& p = run.tissue().particles();
     const Eigen::Index np = p.size();
     Eigen::MatrixX3d x(np, 3), u(np, 3), v(np, 3);
-    Eigen::VectorXd plastic(np), mises(np), contact(np);
+    Eigen::VectorXd plastic(np), effective(np), mises(np), contact(np);
     const std::vector<std::uint8_t> in_contact = run.contact_model().in_contact();
     for (Eigen::Index i = 0; i < np; ++i) {
       const size_t s = static_cast<size_t>(i);
@@ -102,13 +124,14 @@ class InsertionOutput {
       u.row(i) = (p.position_mm[s] - p.initial_mm[s]).transpose();
       v.row(i) = p.velocity_mm_per_ms[s].transpose();
       plastic[i] = p.plastic_strain[s];
+      effective[i] = p.effective_strain[s];
       const Mat3d dev = p.stress_MPa[s] - p.stress_MPa[s].trace() / 3 * Mat3d::Identity();
       mises[i] = std::sqrt(1.5 * dev.squaredNorm());
       contact[i] = in_contact[s];
     }
     const std::string tissue_name = fmt::format("frames/tissue_{:04}.vtp", index);
     write_vtp(folder_.path(tissue_name).string(), x,
-              {{"displacement_mm", u}, {"velocity_m_per_s", v}, {"plastic_strain", plastic}, {"von_mises_MPa", mises},
+              {{"displacement_mm", u}, {"velocity_m_per_s", v}, {"plastic_strain", plastic}, {"effective_strain", effective}, {"von_mises_MPa", mises},
                {"broken_bonds", broken_bonds(run.tissue())}, {"in_contact", contact}});
     tissue_frames_.emplace_back(run.time_ms(), tissue_name);
   }
@@ -128,6 +151,14 @@ class InsertionOutput {
 };
 
 }  // namespace
+
+Scene default_run_scene() {
+  Scene s = parse_scene("{}", "(needle run defaults)");
+  s.tissue.enabled = true;
+  s.needle.mesh.size_mm = 0.4;
+  s.solver.mass_scaling_dt_ms = 5e-6;
+  return s;
+}
 
 void run_insertion(const Scene& scene, const RunOptions& o) {
   NEEDLE_REQUIRE(scene.tissue.enabled, "run_insertion needs a scene with tissue.enabled");
@@ -171,7 +202,7 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
                        scene.solver.coupling.contact_courant * run.contact_model().stable_time_step_ms()));
 
   InsertionOutput output(folder, surface);
-  output.record(run, tip);
+  output.record(run, tip, run_groove_fill(run, built, scene));
   if (scene.output.frames > 0) output.frame(run);
   ProgressBar progress(end_ms, o.quiet);
   std::string status = "finished", reason;
@@ -182,7 +213,7 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
     while (run.time_ms() < end_ms - 1e-12) {
       run.step(end_ms);
       if (run.time_ms() >= next_history - 1e-12 || run.time_ms() >= end_ms - 1e-12) {
-        output.record(run, tip);
+        output.record(run, tip, run_groove_fill(run, built, scene));
         next_history += scene.output.history_interval_ms;
       }
       if (scene.output.frames > 0 && run.time_ms() >= next_frame * end_ms / scene.output.frames - 1e-12) {
@@ -194,7 +225,7 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
   } catch (const SolverError& e) {
     status = "stopped";
     reason = e.what();
-    output.record(run, tip);
+    output.record(run, tip, run_groove_fill(run, built, scene));
   }
   progress.finish();
   const double solve_s = std::chrono::duration<double>(Clock::now() - solve_start).count();
@@ -203,6 +234,7 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
   const Eigen::RowVector3d u = needle_run.positions_mm().row(tip) - needle.mesh().X.row(tip);
   const double deflection = u.y() - needle_run.drive_displacement_mm().y();
   const InsertionEnergy& e = run.energy();
+  const GrooveFill groove = run_groove_fill(run, built, scene);
   const json summary = {
       {"status", status},
       {"reason", reason},
@@ -227,6 +259,14 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
       {"max_particles_inside", run.max_particles_inside()},
       {"particles", particles.num_particles()},
       {"bonds_broken", run.bonds_broken()},
+      {"groove",
+       {{"groove_fill", groove.groove_fill},
+        {"floor_contact_fraction", groove.floor_contact_fraction},
+        {"mean_gap_mm", groove.mean_gap_mm},
+        {"length_in_tissue_mm", groove.length_in_tissue_mm},
+        {"particles_in_groove", groove.particles_in_groove},
+        {"definition", "docs/insertion.md#groove-fill: mean over the groove's length in tissue of the filled share of its depth "
+                       "(tissue's lowest edge to the rod's top over floor to top), in the needle's own frame"}}},
       {"runtime_s", std::chrono::duration<double>(Clock::now() - start).count()},
       {"solve_s", solve_s},
       {"peak_memory_MiB", peak_memory_MiB()},
@@ -245,7 +285,7 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
   if (!o.quiet)
     fmt::print("{} {}: deflection {:.6g} mm, {} steps ({} needle steps), {:.1f} s -> {}\n", built.name, status, deflection, run.steps(),
                run.needle_steps(), solve_s, folder.final_path().string());
-  if (status != "finished") throw SolverError(reason + fmt::format(" (what was written so far is in {})", o.out_dir));
+  if (status != "finished" && o.throw_on_stop) throw SolverError(reason + fmt::format(" (what was written so far is in {})", o.out_dir));
 }
 
 }  // namespace needle

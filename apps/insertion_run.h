@@ -11,10 +11,16 @@ namespace needle {
 struct RunOptions {
   std::string out_dir;
   bool overwrite = false, quiet = false;
-  int threads = -1;  // -1: the scene's solver.threads
+  bool throw_on_stop = true;  // false: a run the solver stopped returns normally (its summary says so)
+  int threads = -1;           // -1: the scene's solver.threads
 };
 
-// InputError (nothing written) for bad input; SolverError after writing the folder if the solver stopped.
+// The run defaults of `needle run` and `needle paper`: the paper's scene with tissue, and the needle
+// fidelity that keeps a 30 mm run within minutes (docs/insertion.md measures its error).
+Scene default_run_scene();
+
+// InputError (nothing written) for bad input; SolverError after writing the folder if the solver stopped
+// (unless !throw_on_stop).
 void run_insertion(const Scene& scene, const RunOptions& options);
 
 }  // namespace needle

@@ -23,16 +23,6 @@ struct RunCommandOptions {
   RunOptions run;
 };
 
-// The run defaults: the paper's scene with tissue, and the needle fidelity that keeps a 30 mm run
-// within minutes (docs/insertion.md measures its error against the paper's 0.2 mm mesh).
-Scene default_run_scene() {
-  Scene s = parse_scene("{}", "(needle run defaults)");
-  s.tissue.enabled = true;
-  s.needle.mesh.size_mm = 0.4;
-  s.solver.mass_scaling_dt_ms = 5e-6;
-  return s;
-}
-
 void run(const RunCommandOptions& o) {
   const int sources = !o.preset.empty() + !std::isnan(o.d_a_mm) + !o.recipe.empty();
   NEEDLE_REQUIRE(sources <= 1, "give one of --preset, --d-a or --recipe");

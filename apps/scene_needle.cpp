@@ -32,6 +32,8 @@ SceneNeedle build_scene_needle(const NeedleScene& n) {
   out.name = tip.name;
   out.mesh = build.mesh;
   out.tip_point = tip.tip_point;
+  out.groove = tip.groove;
+  out.radius_mm = tip.radius_mm;
   out.mesh_seconds = build.mesh_seconds;
   return out;
 }

@@ -3,9 +3,11 @@
 // or a mesh file, with its tip point A; its dynamics options; its ParaView frames. Shared by
 // `needle simulate` and `needle run`.
 #include <Eigen/Dense>
+#include <optional>
 #include <string>
 
 #include "apps/scene.h"
+#include "geometry/tip_geometry.h"
 #include "mesher/tet_mesh.h"
 #include "solver/needle_dynamics.h"
 
@@ -15,6 +17,8 @@ struct SceneNeedle {
   std::string name;
   TetMesh mesh;
   Eigen::Vector3d tip_point = Eigen::Vector3d::Zero();  // A (for a mesh file: its most distal node)
+  std::optional<GrooveBox> groove;  // in the mesh's frame (absent for a mesh file or a groove-less tip)
+  double radius_mm = 0.5;
   double mesh_seconds = 0;
 };
 
