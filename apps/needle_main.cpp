@@ -4,7 +4,9 @@
 #include <fmt/format.h>
 
 #include "apps/material_test_command.h"
+#include "apps/calibrate_command.h"
 #include "apps/mesh_command.h"
+#include "apps/paper_command.h"
 #include "apps/run_command.h"
 #include "apps/simulate_command.h"
 #include "apps/stiffness_command.h"
@@ -22,6 +24,8 @@ int main(int argc, char** argv) {
   needle::add_stiffness_command(app);
   needle::add_simulate_command(app);
   needle::add_run_command(app);
+  needle::add_paper_command(app);
+  needle::add_calibrate_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

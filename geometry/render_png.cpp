@@ -83,7 +83,7 @@ void draw_panel(const TriSurface& s, const RenderOptions& options, const Eigen::
 
 }  // namespace
 
-void render_tip_png(const TriSurface& s, const std::string& path, const RenderOptions& options) {
+RgbImage render_tip_image(const TriSurface& s, const RenderOptions& options) {
   const int w = options.panel_width_px, h = options.panel_height_px, header = 40, legend = 60;
   RgbImage image(w, 2 * h + header + legend);
   TextWriter text(18), small(15);
@@ -108,6 +108,11 @@ void render_tip_png(const TriSurface& s, const std::string& path, const RenderOp
     small.draw(image, x + 21, y + 14, name, ink);
     x += item_width;
   }
+  return image;
+}
+
+void render_tip_png(const TriSurface& s, const std::string& path, const RenderOptions& options) {
+  const RgbImage image = render_tip_image(s, options);
   write_file_atomically(path, [&](const std::string& scratch_path) { write_png(image, scratch_path); });
 }
 

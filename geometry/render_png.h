@@ -4,6 +4,7 @@
 #include <string>
 
 #include "geometry/tri_surface.h"
+#include "plot/raster_image.h"
 
 namespace needle {
 
@@ -14,6 +15,7 @@ struct RenderOptions {
   std::string title;
 };
 
+RgbImage render_tip_image(const TriSurface& surface, const RenderOptions& options);
 void render_tip_png(const TriSurface& surface, const std::string& path, const RenderOptions& options);
 
 }  // namespace needle

@@ -5,26 +5,9 @@
 #include <fmt/format.h>
 
 #include "geometry/input_error.h"
+#include "plot/axis_ticks.h"
 
 namespace needle {
-namespace {
-
-// Tick spacing 1, 2 or 5 x 10^k giving about `target` intervals.
-double nice_step(double span, int target) {
-  const double raw = span / target;
-  const double magnitude = std::pow(10.0, std::floor(std::log10(raw)));
-  for (double m : {1.0, 2.0, 5.0, 10.0})
-    if (m * magnitude >= raw) return m * magnitude;
-  return 10 * magnitude;
-}
-
-std::string tick_label(double value, double step) {
-  const int decimals = std::max(0, static_cast<int>(-std::floor(std::log10(step) + 1e-9)));
-  if (std::abs(value) < 1e-12 * step) value = 0;
-  return fmt::format("{:.{}f}", value, decimals);
-}
-
-}  // namespace
 
 Rgb plot_color(int index) {
   static const Rgb palette[] = {{31, 119, 180}, {214, 39, 40}, {44, 160, 44}, {255, 127, 14},
@@ -46,7 +29,7 @@ RgbImage draw_line_plot(const LinePlot& plot) {
   if (x_min < 0 && x_min > -1e-9 * std::abs(x_max)) x_min = 0;
   if (x_max - x_min < 1e-300) x_min -= 0.5, x_max += 0.5;
   if (y_max - y_min < 1e-300) y_min -= 0.5, y_max += 0.5;
-  const double x_step = nice_step(x_max - x_min, 8), y_step = nice_step(y_max - y_min, 6);
+  const double x_step = nice_tick_step(x_max - x_min, 8), y_step = nice_tick_step(y_max - y_min, 6);
   x_min = std::floor(x_min / x_step) * x_step, x_max = std::ceil(x_max / x_step) * x_step;
   y_min = std::floor(y_min / y_step) * y_step, y_max = std::ceil(y_max / y_step) * y_step;
 

@@ -25,6 +25,14 @@ void RgbImage::blend(int x, int y, const Rgb& c, double alpha) {
   }
 }
 
+void RgbImage::paste(const RgbImage& src, int x, int y) {
+  for (int j = 0; j < src.height; ++j)
+    for (int i = 0; i < src.width; ++i) {
+      const size_t k = static_cast<size_t>(3 * (j * src.width + i));
+      set(x + i, y + j, {src.rgb[k], src.rgb[k + 1], src.rgb[k + 2]});
+    }
+}
+
 void RgbImage::fill_rect(int x0, int y0, int x1, int y1, const Rgb& c) {
   for (int y = std::max(0, y0); y < std::min(height, y1); ++y)
     for (int x = std::max(0, x0); x < std::min(width, x1); ++x) set(x, y, c);

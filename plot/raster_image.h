@@ -19,6 +19,8 @@ struct RgbImage {
   // Anti-aliased line of the given width in pixels; dash_px > 0 draws dashes of that length.
   void line(double x0, double y0, double x1, double y1, const Rgb& c, double width_px = 1.5, double dash_px = 0);
   void fill_rect(int x0, int y0, int x1, int y1, const Rgb& c);
+  // Copies src with its top-left corner at (x, y), clipped to this image.
+  void paste(const RgbImage& src, int x, int y);
 };
 
 // Draws text with its baseline at y; silently draws nothing if no font is installed.

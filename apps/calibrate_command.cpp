@@ -1,0 +1,187 @@
+// `needle calibrate`: finds the tissue's Young's modulus (the one parameter the paper does not give)
+// for which a needle's insertion ends at the measured deflection. Each evaluation is a full run of the
+// paper's scene (DIR/runs/E_<value>MPa, reused when already there with the same scene); the first step
+// assumes deflection proportional to E, the next ones are secant steps on the last two runs. Writes
+// DIR/calibration.json (E, every run, the sensitivity d delta / d E) and DIR/calibration.png.
+#include "apps/calibrate_command.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fmt/format.h>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "apps/insertion_run.h"
+#include "apps/scene.h"
+#include "geometry/input_error.h"
+#include "geometry/mesh_io.h"
+#include "plot/line_plot.h"
+
+namespace needle {
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+namespace {
+
+struct CalibrateOptions {
+  std::string preset = "SB", out_dir;
+  double target_mm = std::nan(""), start_E_MPa = std::nan(""), tolerance_mm = 0.05, travel_mm = std::nan(""), spacing_mm = std::nan("");
+  int max_runs = 4, threads = -1;
+  bool quiet = false;
+};
+
+struct Evaluation {
+  double E_MPa = 0, deflection_mm = 0, insertion_mm = 0, runtime_s = 0;
+  std::string status, folder;
+};
+
+Evaluation evaluate(const Scene& base, double E, const fs::path& runs_dir, const CalibrateOptions& o) {
+  Scene scene = base;
+  scene.tissue.material.E_MPa = E;
+  scene.tissue.material.validate();
+  const fs::path folder = runs_dir / fmt::format("E_{:.6g}MPa", E);
+  bool reuse = false;
+  {
+    std::ifstream stored(folder / "scene.json"), summary(folder / "summary.json");
+    if (stored.good() && summary.good()) {
+      try {
+        reuse = json::parse(stored) == json::parse(scene_to_json(scene).dump());
+      } catch (const json::exception&) {
+        reuse = false;
+      }
+    }
+  }
+  if (!reuse) {
+    if (!o.quiet) fmt::print("E = {:.6g} MPa: running {} into {}\n", E, o.preset, folder.string());
+    RunOptions run;
+    run.out_dir = folder.string();
+    run.overwrite = true;
+    run.quiet = o.quiet;
+    run.threads = o.threads;
+    run.throw_on_stop = false;
+    run_insertion(scene, run);
+  } else if (!o.quiet) {
+    fmt::print("E = {:.6g} MPa: reusing {}\n", E, folder.string());
+  }
+  std::ifstream in(folder / "summary.json");
+  const json s = json::parse(in);
+  Evaluation e;
+  e.E_MPa = E;
+  e.deflection_mm = s.at("deflection_mm").get<double>();
+  e.insertion_mm = s.at("insertion_mm").get<double>();
+  e.runtime_s = s.at("runtime_s").get<double>();
+  e.status = s.at("status").get<std::string>();
+  e.folder = folder.string();
+  return e;
+}
+
+void calibrate(const CalibrateOptions& o) {
+  NEEDLE_REQUIRE(o.preset == "SB" || o.preset == "LMB" || o.preset == "AMB" || o.preset == "HMB",
+                 fmt::format("--preset '{}' is not one of SB, LMB, AMB, HMB", o.preset));
+  NEEDLE_REQUIRE(std::isfinite(o.target_mm) && o.target_mm != 0, "--target-deflection-mm must be a non-zero number (SB: -1.14)");
+  NEEDLE_REQUIRE(std::isfinite(o.tolerance_mm) && o.tolerance_mm > 0, "--tolerance-mm must be positive");
+  NEEDLE_REQUIRE(o.max_runs >= 2 && o.max_runs <= 20, "--max-runs must lie in [2, 20]");
+  Scene scene = default_run_scene();
+  scene.needle.preset = o.preset;
+  if (!std::isnan(o.travel_mm)) {
+    scene.motion.travel_mm = o.travel_mm;
+    scene.motion.validate("--travel-mm");
+  }
+  if (!std::isnan(o.spacing_mm)) {
+    NEEDLE_REQUIRE(std::isfinite(o.spacing_mm) && o.spacing_mm > 0, "--spacing-mm must be positive");
+    scene.tissue.spacing_mm = o.spacing_mm;
+  }
+  const double start = std::isnan(o.start_E_MPa) ? scene.tissue.material.E_MPa : o.start_E_MPa;
+  NEEDLE_REQUIRE(std::isfinite(start) && start > 0, "--start-E-MPa must be positive");
+  const fs::path dir(o.out_dir);
+  NEEDLE_REQUIRE(fs::is_directory(fs::absolute(dir).parent_path()),
+                 fmt::format("the folder '{}' that should hold the calibration does not exist", fs::absolute(dir).parent_path().string()));
+  fs::create_directories(dir / "runs");
+
+  std::vector<Evaluation> runs;
+  runs.push_back(evaluate(scene, start, dir / "runs", o));
+  auto converged = [&](const Evaluation& e) { return e.status == "finished" && std::abs(e.deflection_mm - o.target_mm) <= o.tolerance_mm; };
+  while (!converged(runs.back()) && static_cast<int>(runs.size()) < o.max_runs) {
+    const Evaluation& last = runs.back();
+    double next;
+    if (runs.size() == 1 || std::abs(last.deflection_mm - runs[runs.size() - 2].deflection_mm) < 1e-9) {
+      NEEDLE_REQUIRE(last.deflection_mm * o.target_mm > 0,
+                     fmt::format("at E = {:.4g} MPa the needle deflects {:+.3f} mm, the other way than the target {:+.3f} mm: "
+                                 "E alone cannot calibrate it",
+                                 last.E_MPa, last.deflection_mm, o.target_mm));
+      next = last.E_MPa * o.target_mm / last.deflection_mm;  // deflection proportional to E
+    } else {
+      const Evaluation& before = runs[runs.size() - 2];
+      const double slope = (last.deflection_mm - before.deflection_mm) / (last.E_MPa - before.E_MPa);
+      next = last.E_MPa + (o.target_mm - last.deflection_mm) / slope;
+    }
+    next = std::clamp(next, last.E_MPa / 10, last.E_MPa * 10);  // a step of at most a decade
+    runs.push_back(evaluate(scene, next, dir / "runs", o));
+  }
+
+  // The best run, and the sensitivity from the two runs closest to the target.
+  std::vector<Evaluation> sorted = runs;
+  std::sort(sorted.begin(), sorted.end(),
+            [&](const auto& a, const auto& b) { return std::abs(a.deflection_mm - o.target_mm) < std::abs(b.deflection_mm - o.target_mm); });
+  const Evaluation& best = sorted.front();
+  double slope = std::nan("");
+  if (sorted.size() >= 2 && std::abs(sorted[1].E_MPa - best.E_MPa) > 0)
+    slope = (sorted[1].deflection_mm - best.deflection_mm) / (sorted[1].E_MPa - best.E_MPa);
+  json list = json::array();
+  for (const Evaluation& e : runs)
+    list.push_back({{"E_MPa", e.E_MPa}, {"deflection_mm", e.deflection_mm}, {"status", e.status}, {"insertion_mm", e.insertion_mm},
+                    {"runtime_s", e.runtime_s}, {"run_folder", fs::relative(e.folder, dir).string()}});
+  const json out = {{"needle", o.preset},
+                    {"target_deflection_mm", o.target_mm},
+                    {"tolerance_mm", o.tolerance_mm},
+                    {"converged", converged(best)},
+                    {"tissue_E_MPa", best.E_MPa},
+                    {"deflection_mm", best.deflection_mm},
+                    {"sensitivity_mm_per_MPa", std::isfinite(slope) ? json(slope) : json(nullptr)},
+                    {"relative_sensitivity", std::isfinite(slope) ? json(slope * best.E_MPa / best.deflection_mm) : json(nullptr)},
+                    {"runs", list}};
+  write_file_atomically((dir / "calibration.json").string(), [&](const std::string& scratch) { std::ofstream(scratch) << out.dump(2) << "\n"; });
+  LinePlot plot;
+  plot.title = fmt::format("Calibration of the tissue's E on {} (target {:+.2f} mm)", o.preset, o.target_mm);
+  plot.x_label = "tissue Young's modulus E (MPa)";
+  plot.y_label = "deflection at the end (mm)";
+  PlotSeries points{"runs", {}, {}, plot_color(0), false, true};
+  for (const Evaluation& e : sorted) points.x.push_back(e.E_MPa), points.y.push_back(e.deflection_mm);
+  std::vector<size_t> order(points.x.size());
+  for (size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return points.x[a] < points.x[b]; });
+  PlotSeries line = points;
+  for (size_t k = 0; k < order.size(); ++k) line.x[k] = points.x[order[k]], line.y[k] = points.y[order[k]];
+  line.markers = true;
+  double lo = line.x.front(), hi = line.x.back();
+  PlotSeries target{"target", {lo, hi}, {o.target_mm, o.target_mm}, plot_color(1), true, false};
+  plot.series = {line, target};
+  const RgbImage image = draw_line_plot(plot);
+  write_file_atomically((dir / "calibration.png").string(), [&](const std::string& scratch) { write_png(image, scratch); });
+  if (!o.quiet)
+    fmt::print("{}: E = {:.4g} MPa gives {:+.3f} mm (target {:+.3f}, {}); wrote {}\n", o.preset, best.E_MPa, best.deflection_mm, o.target_mm,
+               converged(best) ? "within tolerance" : "NOT within tolerance", (dir / "calibration.json").string());
+}
+
+}  // namespace
+
+void add_calibrate_command(CLI::App& app) {
+  auto o = std::make_shared<CalibrateOptions>();
+  CLI::App* c = app.add_subcommand("calibrate", "Find the tissue E for which a needle's paper insertion ends at a measured deflection "
+                                                "(secant on full runs; docs/paper.md)");
+  c->add_option("--preset", o->preset, "The needle to calibrate on (default SB: the paper's calibration needle)");
+  c->add_option("--target-deflection-mm", o->target_mm, "Measured deflection at the end (SB: -1.14)")->required();
+  c->add_option("--out", o->out_dir, "Calibration folder (created; runs go to OUT/runs/E_<E>MPa)")->required();
+  c->add_option("--start-E-MPa", o->start_E_MPa, "First E to run (default: the card's 0.665)");
+  c->add_option("--tolerance-mm", o->tolerance_mm, "Stop when within this of the target (default 0.05)");
+  c->add_option("--max-runs", o->max_runs, "Most runs to make (default 4)");
+  c->add_option("--travel-mm", o->travel_mm, "Insertion travel (default 30)");
+  c->add_option("--spacing-mm", o->spacing_mm, "Tissue particle spacing (default 0.4)");
+  c->add_flag("--quiet", o->quiet, "No progress bars or result lines");
+  c->add_option("--threads", o->threads, "Worker threads (default: the scene's; 0: all cores)");
+  c->callback([o] { calibrate(*o); });
+}
+
+}  // namespace needle

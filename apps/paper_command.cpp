@@ -1,0 +1,176 @@
+// `needle paper`: runs SB, LMB, AMB and HMB on the paper's scene with the run defaults (or reuses runs
+// already in the report folder with the same scene) and writes the report (apps/paper_report.h).
+#include "apps/paper_command.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fmt/format.h>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "apps/insertion_run.h"
+#include "apps/paper_report.h"
+#include "apps/scene.h"
+#include "geometry/input_error.h"
+
+#ifndef NEEDLE_DATA_DIR
+#define NEEDLE_DATA_DIR "data"
+#endif
+
+namespace needle {
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+namespace {
+
+struct PaperOptions {
+  std::string out_dir, needles = "SB,LMB,AMB,HMB", reference = std::string(NEEDLE_DATA_DIR) + "/paper/reference.json";
+  std::string calibration_file;
+  double tissue_E_MPa = std::nan(""), travel_mm = std::nan(""), spacing_mm = std::nan(""), mesh_size_mm = std::nan("");
+  bool report_only = false, rerun = false, no_tips = false, quiet = false;
+  int threads = -1;
+  std::string command_line;
+};
+
+std::vector<std::string> split_names(const std::string& list) {
+  std::vector<std::string> out;
+  std::stringstream in(list);
+  std::string name;
+  while (std::getline(in, name, ','))
+    if (!name.empty()) out.push_back(name);
+  NEEDLE_REQUIRE(!out.empty(), "--needles names no needle");
+  for (const std::string& n : out)
+    NEEDLE_REQUIRE(n == "SB" || n == "LMB" || n == "AMB" || n == "HMB", fmt::format("--needles: '{}' is not one of SB, LMB, AMB, HMB", n));
+  return out;
+}
+
+// E from a calibration file written by `needle calibrate` (its tissue_E_MPa).
+double calibrated_E(const std::string& path) {
+  std::ifstream in(path);
+  NEEDLE_REQUIRE(in.good(), fmt::format("cannot read the calibration '{}'", path));
+  json j;
+  try {
+    j = json::parse(in);
+  } catch (const json::exception& e) {
+    throw InputError(fmt::format("{}: not valid JSON ({})", path, e.what()));
+  }
+  NEEDLE_REQUIRE(j.contains("tissue_E_MPa") && j["tissue_E_MPa"].is_number() && j["tissue_E_MPa"].get<double>() > 0,
+                 fmt::format("{}: tissue_E_MPa must be a positive number", path));
+  return j["tissue_E_MPa"].get<double>();
+}
+
+// True if the folder holds a run (summary.json) of exactly this scene.
+bool has_run_of(const fs::path& folder, const Scene& scene) {
+  std::ifstream summary(folder / "summary.json"), stored(folder / "scene.json");
+  if (!summary.good() || !stored.good()) return false;
+  try {
+    return json::parse(stored) == json::parse(scene_to_json(scene).dump());
+  } catch (const json::exception&) {
+    return false;
+  }
+}
+
+void paper(const PaperOptions& o) {
+  const std::vector<std::string> needles = split_names(o.needles);
+  const std::vector<PaperReferenceNeedle> reference = read_paper_reference(o.reference);
+  NEEDLE_REQUIRE(std::isnan(o.tissue_E_MPa) || o.calibration_file.empty(), "give --tissue-E-MPa or --calibration, not both");
+  Scene scene = default_run_scene();
+  std::string E_source = fmt::format("the default card value, {} MPa (docs/solver.md)", scene.tissue.material.E_MPa);
+  if (!o.calibration_file.empty()) {
+    scene.tissue.material.E_MPa = calibrated_E(o.calibration_file);
+    E_source = fmt::format("calibrated on SB: {}", o.calibration_file);
+  } else if (!std::isnan(o.tissue_E_MPa)) {
+    NEEDLE_REQUIRE(std::isfinite(o.tissue_E_MPa) && o.tissue_E_MPa > 0, "--tissue-E-MPa must be a positive number");
+    scene.tissue.material.E_MPa = o.tissue_E_MPa;
+    E_source = "given with --tissue-E-MPa";
+  }
+  scene.tissue.material.validate();
+  auto positive = [](double v, const char* flag) {
+    NEEDLE_REQUIRE(std::isnan(v) || (std::isfinite(v) && v > 0), fmt::format("{} must be a positive number (got {})", flag, v));
+    return !std::isnan(v);
+  };
+  if (positive(o.travel_mm, "--travel-mm")) {
+    scene.motion.travel_mm = o.travel_mm;
+    scene.motion.validate("--travel-mm");
+  }
+  if (positive(o.spacing_mm, "--spacing-mm")) scene.tissue.spacing_mm = o.spacing_mm;
+  if (positive(o.mesh_size_mm, "--mesh-size-mm")) scene.needle.mesh.size_mm = o.mesh_size_mm;
+
+  const fs::path dir(o.out_dir);
+  const fs::path parent = fs::absolute(dir).parent_path();
+  NEEDLE_REQUIRE(fs::is_directory(parent), fmt::format("the folder '{}' that should hold the report does not exist", parent.string()));
+  NEEDLE_REQUIRE(!fs::exists(dir) || fs::is_directory(dir), fmt::format("'{}' exists and is not a folder", dir.string()));
+  if (!o.report_only) {
+    fs::create_directories(dir / "runs");
+    for (const std::string& name : needles) {
+      Scene s = scene;
+      s.needle.preset = name;
+      s.needle.recipe_file.clear();
+      s.needle.mesh_file.clear();
+      s.needle.d_a_mm = std::nan("");
+      s.needle.plain_rod = false;
+      const fs::path folder = dir / "runs" / name;
+      if (!o.rerun && has_run_of(folder, s)) {
+        if (!o.quiet) fmt::print("{}: reusing the run in {}\n", name, folder.string());
+        continue;
+      }
+      if (!o.quiet) fmt::print("{}: running the paper's insertion into {}\n", name, folder.string());
+      RunOptions run;
+      run.out_dir = folder.string();
+      run.overwrite = true;
+      run.quiet = o.quiet;
+      run.threads = o.threads;
+      run.throw_on_stop = false;  // a stopped run is reported as such, with what it reached
+      run_insertion(s, run);
+    }
+  }
+  PaperReportInput report;
+  report.out_dir = o.out_dir;
+  report.needles = needles;
+  report.reference = reference;
+  report.reference_path = o.reference;
+  report.tissue_E_MPa = scene.tissue.material.E_MPa;
+  report.tissue_E_source = E_source;
+  report.command_line = o.command_line;
+  report.draw_tips = !o.no_tips;
+  write_paper_report(report);
+  if (!o.quiet) fmt::print("wrote {}\n", (dir / "report.md").string());
+}
+
+}  // namespace
+
+void add_paper_command(CLI::App& app) {
+  auto o = std::make_shared<PaperOptions>();
+  CLI::App* c = app.add_subcommand("paper", "Reproduce the paper: SB, LMB, AMB and HMB on the paper's scene, and a report with the "
+                                            "deflection table, groove filling and plots (docs/paper.md)");
+  c->add_option("--out", o->out_dir, "Report folder (created; runs go to OUT/runs/NAME)")->required();
+  c->add_option("--needles", o->needles, "Comma-separated needles (default SB,LMB,AMB,HMB)");
+  c->add_option("--tissue-E-MPa", o->tissue_E_MPa, "Tissue Young's modulus (default: the card's 0.665 MPa)");
+  c->add_option("--calibration", o->calibration_file, "calibration.json from `needle calibrate` (its tissue_E_MPa)");
+  c->add_option("--reference", o->reference, "The paper's reference table (default data/paper/reference.json)");
+  c->add_option("--travel-mm", o->travel_mm, "Insertion travel (default 30; shorter for a quick look)");
+  c->add_option("--spacing-mm", o->spacing_mm, "Tissue particle spacing (default 0.4)");
+  c->add_option("--mesh-size-mm", o->mesh_size_mm, "Needle mesh size (run default 0.4)");
+  c->add_flag("--report-only", o->report_only, "Only rewrite the report from the run folders already in OUT/runs");
+  c->add_flag("--rerun", o->rerun, "Run every needle again even if OUT/runs holds a run of the same scene");
+  c->add_flag("--no-tips", o->no_tips, "Skip the tip pictures (they need the CAD booleans, a few seconds each)");
+  c->add_flag("--quiet", o->quiet, "No progress bars or result lines");
+  c->add_option("--threads", o->threads, "Worker threads (default: the scene's; 0: all cores)");
+  c->callback([o, c] {
+    // The command that regenerates the report (its runs are reused).
+    std::string& line = o->command_line;
+    line = fmt::format("needle paper --out {}", o->out_dir);
+    if (c->count("--needles")) line += " --needles " + o->needles;
+    if (c->count("--tissue-E-MPa")) line += fmt::format(" --tissue-E-MPa {}", o->tissue_E_MPa);
+    if (c->count("--calibration")) line += " --calibration " + o->calibration_file;
+    if (c->count("--reference")) line += " --reference " + o->reference;
+    if (c->count("--travel-mm")) line += fmt::format(" --travel-mm {}", o->travel_mm);
+    if (c->count("--spacing-mm")) line += fmt::format(" --spacing-mm {}", o->spacing_mm);
+    if (c->count("--mesh-size-mm")) line += fmt::format(" --mesh-size-mm {}", o->mesh_size_mm);
+    paper(*o);
+  });
+}
+
+}  // namespace needle

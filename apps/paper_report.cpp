@@ -1,0 +1,405 @@
+#include "apps/paper_report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fmt/format.h>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <nlohmann/json.hpp>
+
+#include "apps/csv_table.h"
+#include "geometry/cad_solid.h"
+#include "geometry/grinding_recipe.h"
+#include "geometry/input_error.h"
+#include "geometry/mesh_io.h"
+#include "geometry/render_png.h"
+#include "geometry/tip_report.h"
+#include "plot/bar_chart.h"
+#include "plot/line_plot.h"
+
+namespace needle {
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+namespace {
+
+const std::vector<std::string> kPaperOrder = {"SB", "LMB", "AMB", "HMB"};
+const Rgb kOurs{31, 119, 180}, kExperiment{60, 60, 60}, kLsDyna{255, 127, 14};
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// What one needle's run folder says.
+struct NeedleRun {
+  std::string name, folder, status, reason;
+  double deflection_mm = kNaN, insertion_mm = kNaN, runtime_s = kNaN, groove_fill = kNaN, floor_contact_fraction = kNaN,
+         mean_gap_mm = kNaN, max_energy_error = kNaN, max_penetration_mm = kNaN;
+  long bonds_broken = 0, particles_inside = 0, steps = 0;
+  CsvTable history, facets;
+};
+
+double number_or_nan(const json& j, const char* key) {
+  return j.contains(key) && j[key].is_number() ? j[key].get<double>() : kNaN;
+}
+
+NeedleRun read_run(const std::string& out_dir, const std::string& name) {
+  NeedleRun r;
+  r.name = name;
+  r.folder = (fs::path(out_dir) / "runs" / name).string();
+  const std::string summary_path = (fs::path(r.folder) / "summary.json").string();
+  std::ifstream in(summary_path);
+  NEEDLE_REQUIRE(in.good(), fmt::format("no run of {}: '{}' is missing (run `needle paper` without --report-only first)", name, summary_path));
+  json s;
+  try {
+    s = json::parse(in);
+  } catch (const json::exception& e) {
+    throw InputError(fmt::format("{}: not valid JSON ({})", summary_path, e.what()));
+  }
+  r.status = s.value("status", std::string("unknown"));
+  r.reason = s.value("reason", std::string());
+  r.deflection_mm = number_or_nan(s, "deflection_mm");
+  r.insertion_mm = number_or_nan(s, "insertion_mm");
+  r.runtime_s = number_or_nan(s, "runtime_s");
+  r.max_energy_error = number_or_nan(s, "max_energy_balance_error");
+  r.max_penetration_mm = number_or_nan(s, "max_penetration_mm");
+  r.bonds_broken = s.value("bonds_broken", 0L);
+  r.particles_inside = s.value("particles_inside", 0L);
+  r.steps = s.value("steps", 0L);
+  if (s.contains("groove") && s["groove"].is_object()) {
+    r.groove_fill = number_or_nan(s["groove"], "groove_fill");
+    r.floor_contact_fraction = number_or_nan(s["groove"], "floor_contact_fraction");
+    r.mean_gap_mm = number_or_nan(s["groove"], "mean_gap_mm");
+  }
+  r.history = read_csv_table((fs::path(r.folder) / "history.csv").string());
+  r.facets = read_csv_table((fs::path(r.folder) / "facet_forces.csv").string());
+  return r;
+}
+
+const PaperReferenceNeedle* find_reference(const std::vector<PaperReferenceNeedle>& reference, const std::string& name) {
+  for (const PaperReferenceNeedle& r : reference)
+    if (r.name == name) return &r;
+  return nullptr;
+}
+
+void save_png(const RgbImage& image, const std::string& path) {
+  write_file_atomically(path, [&](const std::string& scratch) { write_png(image, scratch); });
+}
+
+void save_text(const std::string& text, const std::string& path) {
+  write_file_atomically(path, [&](const std::string& scratch) {
+    std::ofstream out(scratch);
+    out << text;
+    NEEDLE_REQUIRE(out.good(), fmt::format("cannot write '{}'", path));
+  });
+}
+
+std::string fmt_mm(double v, const char* f = "{:+.3f}") { return std::isfinite(v) ? fmt::format(fmt::runtime(f), v) : std::string("n/a"); }
+
+// The paper's targets (issue 7), each with its verdict and the numbers behind it.
+struct Target {
+  std::string what, numbers;
+  bool met = false, checked = false;
+};
+
+std::vector<Target> evaluate_targets(const std::vector<NeedleRun>& runs, const std::vector<PaperReferenceNeedle>& reference) {
+  std::map<std::string, const NeedleRun*> by;
+  for (const NeedleRun& r : runs) by[r.name] = &r;
+  auto delta = [&](const char* n) { return by.count(n) ? by[n]->deflection_mm : kNaN; };
+  auto fill = [&](const char* n) { return by.count(n) ? by[n]->groove_fill : kNaN; };
+  std::vector<Target> out;
+  const double sb = delta("SB"), lmb = delta("LMB"), amb = delta("AMB"), hmb = delta("HMB");
+  {
+    Target t{"sign and order: SB < 0 < LMB <~ AMB < HMB (<~: within 0.1 mm)",
+             fmt::format("SB {} / LMB {} / AMB {} / HMB {} mm", fmt_mm(sb), fmt_mm(lmb), fmt_mm(amb), fmt_mm(hmb))};
+    t.checked = std::isfinite(sb + lmb + amb + hmb);
+    t.met = t.checked && sb < 0 && lmb > 0 && lmb <= amb + 0.1 && amb < hmb;
+    out.push_back(t);
+  }
+  for (const char* n : {"SB", "LMB", "AMB"}) {
+    const PaperReferenceNeedle* ref = find_reference(reference, n);
+    Target t{fmt::format("{}: abs(delta - delta_experiment) <= 0.1 mm", n), "n/a"};
+    if (ref && std::isfinite(delta(n))) {
+      const double error = delta(n) - ref->deflection_experiment_mm;
+      t.numbers = fmt::format("{} - ({:+.2f}) = {:+.3f} mm", fmt_mm(delta(n)), ref->deflection_experiment_mm, error);
+      t.checked = true;
+      t.met = std::abs(error) <= 0.1;
+    }
+    out.push_back(t);
+  }
+  if (const PaperReferenceNeedle* ref = find_reference(reference, "HMB")) {
+    const double lsdyna_error = std::abs(ref->deflection_lsdyna_mm - ref->deflection_experiment_mm);
+    Target t{fmt::format("HMB: error below LS-DYNA's {:.2f} mm", lsdyna_error), "n/a"};
+    if (std::isfinite(hmb)) {
+      const double error = std::abs(hmb - ref->deflection_experiment_mm);
+      t.numbers = fmt::format("abs({} - ({:+.2f})) = {:.3f} mm", fmt_mm(hmb), ref->deflection_experiment_mm, error);
+      t.checked = true;
+      t.met = error < lsdyna_error;
+    }
+    out.push_back(t);
+  }
+  {
+    Target t{"groove fill ranks SB and LMB above AMB above HMB",
+             fmt::format("SB {} / LMB {} / AMB {} / HMB {}", fmt_mm(fill("SB"), "{:.3f}"), fmt_mm(fill("LMB"), "{:.3f}"),
+                         fmt_mm(fill("AMB"), "{:.3f}"), fmt_mm(fill("HMB"), "{:.3f}"))};
+    t.checked = std::isfinite(fill("SB") + fill("LMB") + fill("AMB") + fill("HMB"));
+    t.met = t.checked && std::min(fill("SB"), fill("LMB")) > fill("AMB") && fill("AMB") > fill("HMB");
+    out.push_back(t);
+  }
+  return out;
+}
+
+RgbImage deflection_plot(const std::vector<NeedleRun>& runs, const std::vector<PaperReferenceNeedle>& reference) {
+  LinePlot plot;
+  plot.title = "Tip deflection against insertion (circles: experiment at 30 mm)";
+  plot.x_label = "insertion length (mm)";
+  plot.y_label = "deflection of tip point A, +y up (mm)";
+  for (size_t k = 0; k < runs.size(); ++k) {
+    const NeedleRun& r = runs[k];
+    PlotSeries s;
+    s.label = r.name + (r.status == "finished" ? "" : " (stopped)");
+    s.x = r.history.column("insertion_mm");
+    s.y = r.history.column("deflection_mm");
+    s.color = plot_color(static_cast<int>(k));
+    plot.series.push_back(s);
+    if (const PaperReferenceNeedle* ref = find_reference(reference, r.name)) {
+      PlotSeries e;
+      e.x = {30.0};
+      e.y = {ref->deflection_experiment_mm};
+      e.color = s.color;
+      e.markers = true;
+      plot.series.push_back(e);
+    }
+  }
+  return draw_line_plot(plot);
+}
+
+RgbImage deflection_bars(const std::vector<NeedleRun>& runs, const std::vector<PaperReferenceNeedle>& reference) {
+  BarChart chart;
+  chart.title = "Deflection at the end of insertion: this toolkit, experiment, LS-DYNA";
+  chart.y_label = "deflection (mm)";
+  BarSeries ours{"this toolkit", {}, kOurs}, experiment{"experiment", {}, kExperiment}, lsdyna{"LS-DYNA (paper)", {}, kLsDyna};
+  for (const NeedleRun& r : runs) {
+    chart.categories.push_back(r.name);
+    ours.values.push_back(r.deflection_mm);
+    const PaperReferenceNeedle* ref = find_reference(reference, r.name);
+    experiment.values.push_back(ref ? ref->deflection_experiment_mm : kNaN);
+    lsdyna.values.push_back(ref ? ref->deflection_lsdyna_mm : kNaN);
+  }
+  chart.series = {ours, experiment, lsdyna};
+  return draw_bar_chart(chart);
+}
+
+RgbImage groove_bars(const std::vector<NeedleRun>& runs, const std::vector<PaperReferenceNeedle>& reference) {
+  BarChart chart;
+  chart.title = "Groove fill beside the measured sample length";
+  chart.y_label = "fraction";
+  chart.value_format = "{:.2f}";
+  double longest = 0;
+  for (const PaperReferenceNeedle& r : reference) longest = std::max(longest, r.sample_length_mm);
+  BarSeries fill{"groove fill", {}, kOurs}, contact{"floor contact fraction", {}, {44, 160, 44}},
+      sample{"sample length / longest (experiment)", {}, kExperiment};
+  for (const NeedleRun& r : runs) {
+    chart.categories.push_back(r.name);
+    fill.values.push_back(r.groove_fill);
+    contact.values.push_back(r.floor_contact_fraction);
+    const PaperReferenceNeedle* ref = find_reference(reference, r.name);
+    sample.values.push_back(ref && longest > 0 ? ref->sample_length_mm / longest : kNaN);
+  }
+  chart.series = {fill, contact, sample};
+  return draw_bar_chart(chart);
+}
+
+// One panel per needle: the y force the tissue puts on each facet that carries any.
+RgbImage facet_force_panels(const std::vector<NeedleRun>& runs) {
+  const int panel_w = 760, panel_h = 480;
+  const int columns = runs.size() > 1 ? 2 : 1, rows_n = static_cast<int>((runs.size() + 1) / 2);
+  RgbImage image(columns * panel_w, std::max(1, rows_n) * panel_h);
+  for (size_t k = 0; k < runs.size(); ++k) {
+    const NeedleRun& r = runs[k];
+    LinePlot plot;
+    plot.title = fmt::format("{}: y force of the tissue on each facet", r.name);
+    plot.x_label = "insertion length (mm)";
+    plot.y_label = "force y (N), + up";
+    plot.width_px = panel_w, plot.height_px = panel_h;
+    const std::vector<double> x = r.facets.column("insertion_mm");
+    int color = 0;
+    for (const std::string& c : r.facets.columns) {
+      const std::string suffix = "_fy_N";
+      if (c.size() <= suffix.size() || c.compare(c.size() - suffix.size(), suffix.size(), suffix) != 0) continue;
+      const std::vector<double> y = r.facets.column(c);
+      double peak = 0;
+      for (double v : y)
+        if (std::isfinite(v)) peak = std::max(peak, std::abs(v));
+      if (peak < 1e-6) continue;
+      PlotSeries s;
+      s.label = c.substr(0, c.size() - suffix.size());
+      s.x = x;
+      s.y = y;
+      s.color = plot_color(color++);
+      plot.series.push_back(s);
+    }
+    if (plot.series.empty()) continue;
+    image.paste(draw_line_plot(plot), static_cast<int>(k % 2) * panel_w, static_cast<int>(k / 2) * panel_h);
+  }
+  return image;
+}
+
+RgbImage tip_pictures(const std::vector<std::string>& names) {
+  const int panel_w = 620, panel_h = 300, tile_h = 2 * panel_h + 100;
+  const int columns = names.size() > 1 ? 2 : 1, rows_n = static_cast<int>((names.size() + 1) / 2);
+  RgbImage image(columns * panel_w, std::max(1, rows_n) * tile_h);
+  for (size_t k = 0; k < names.size(); ++k) {
+    const GrindingRecipe recipe = preset_recipe(names[k]);
+    const CadSolid solid = build_cad_solid(recipe, false);
+    const TipReport report = make_tip_report(solid, {});
+    RenderOptions o;
+    o.panel_width_px = panel_w;
+    o.panel_height_px = panel_h;
+    o.title = fmt::format("{}   d_a = {}", names[k], report.d_a_mm ? fmt::format("{:+.2f} mm", *report.d_a_mm) : "n/a");
+    o.view_from_x_mm = -std::max(report.tip_length_mm + 1.0, 3.5);
+    image.paste(render_tip_image(solid.surface, o), static_cast<int>(k % 2) * panel_w, static_cast<int>(k / 2) * tile_h);
+  }
+  return image;
+}
+
+bool is_paper_needle(const std::string& name) { return std::find(kPaperOrder.begin(), kPaperOrder.end(), name) != kPaperOrder.end(); }
+
+}  // namespace
+
+std::vector<PaperReferenceNeedle> read_paper_reference(const std::string& path) {
+  std::ifstream in(path);
+  NEEDLE_REQUIRE(in.good(), fmt::format("cannot read the paper's reference table '{}'", path));
+  json j;
+  try {
+    j = json::parse(in);
+  } catch (const json::exception& e) {
+    throw InputError(fmt::format("{}: not valid JSON ({})", path, e.what()));
+  }
+  NEEDLE_REQUIRE(j.contains("needles") && j["needles"].is_object(), fmt::format("{}: no 'needles' object", path));
+  std::vector<PaperReferenceNeedle> out;
+  for (const auto& [name, v] : j["needles"].items()) {
+    PaperReferenceNeedle r;
+    r.name = name;
+    auto number = [&](const char* key) {
+      NEEDLE_REQUIRE(v.contains(key) && v[key].is_number(), fmt::format("{}: needles.{}.{} must be a number", path, name, key));
+      return v[key].get<double>();
+    };
+    r.d_a_mm = number("d_a_mm");
+    r.deflection_experiment_mm = number("deflection_experiment_mm");
+    r.deflection_lsdyna_mm = number("deflection_lsdyna_mm");
+    r.sample_length_mm = number("sample_length_mm");
+    r.groove_contact_in_model = v.value("groove_contact_in_model", std::string());
+    out.push_back(r);
+  }
+  auto rank = [](const std::string& n) {
+    const auto it = std::find(kPaperOrder.begin(), kPaperOrder.end(), n);
+    return static_cast<int>(it - kPaperOrder.begin());
+  };
+  std::stable_sort(out.begin(), out.end(), [&](const auto& a, const auto& b) {
+    return rank(a.name) != rank(b.name) ? rank(a.name) < rank(b.name) : a.name < b.name;
+  });
+  return out;
+}
+
+void write_paper_report(const PaperReportInput& in) {
+  std::vector<NeedleRun> runs;
+  for (const std::string& name : in.needles) runs.push_back(read_run(in.out_dir, name));
+  const std::vector<Target> targets = evaluate_targets(runs, in.reference);
+  const fs::path dir(in.out_dir);
+
+  // results.json
+  json needles = json::object();
+  for (const NeedleRun& r : runs) {
+    json n = {{"deflection_mm", r.deflection_mm},
+              {"groove_fill", r.groove_fill},
+              {"groove_floor_contact_fraction", r.floor_contact_fraction},
+              {"groove_mean_gap_mm", r.mean_gap_mm},
+              {"runtime_s", r.runtime_s},
+              {"status", r.status},
+              {"insertion_mm", r.insertion_mm},
+              {"max_energy_balance_error", r.max_energy_error},
+              {"bonds_broken", r.bonds_broken},
+              {"run_folder", fs::relative(r.folder, dir).string()}};
+    if (!r.reason.empty()) n["reason"] = r.reason;
+    if (const PaperReferenceNeedle* ref = find_reference(in.reference, r.name)) {
+      n["deflection_experiment_mm"] = ref->deflection_experiment_mm;
+      n["deflection_lsdyna_mm"] = ref->deflection_lsdyna_mm;
+      n["error_vs_experiment_mm"] = r.deflection_mm - ref->deflection_experiment_mm;
+      n["sample_length_mm"] = ref->sample_length_mm;
+    }
+    needles[r.name] = n;
+  }
+  json target_list = json::array();
+  for (const Target& t : targets) target_list.push_back({{"target", t.what}, {"numbers", t.numbers}, {"met", t.met}, {"checked", t.checked}});
+  const json results = {{"needles", needles},
+                        {"tissue_E_MPa", in.tissue_E_MPa},
+                        {"tissue_E_source", in.tissue_E_source},
+                        {"groove_fill_definition",
+                         "mean over the groove's length inside the tissue of the share of the groove's depth (floor to the rod's top) "
+                         "that tissue fills, measured in the needle's own frame at the end of insertion (report.md, docs/paper.md)"},
+                        {"targets", target_list},
+                        {"reference", in.reference_path}};
+
+  // The pictures.
+  save_png(deflection_plot(runs, in.reference), (dir / "deflection_vs_insertion.png").string());
+  save_png(deflection_bars(runs, in.reference), (dir / "deflection_bars.png").string());
+  save_png(groove_bars(runs, in.reference), (dir / "groove_fill.png").string());
+  save_png(facet_force_panels(runs), (dir / "facet_forces.png").string());
+  std::vector<std::string> paper_tips;
+  for (const std::string& n : in.needles)
+    if (is_paper_needle(n)) paper_tips.push_back(n);
+  const bool tips = in.draw_tips && !paper_tips.empty();
+  if (tips) save_png(tip_pictures(paper_tips), (dir / "tips.png").string());
+
+  // report.md
+  std::string md;
+  md += "# Multi-bevel needles in PVC: this toolkit against the paper\n\n";
+  md += fmt::format("Regenerate: `{}`\n\n", in.command_line);
+  md += fmt::format("Tissue E = {:.4g} MPa ({}). Every other number is the paper's (shared/SPEC.md); "
+                    "the reference values come from `{}`.\n\n",
+                    in.tissue_E_MPa, in.tissue_E_source, in.reference_path);
+  md += "## Deflection at the end of insertion (mm, +y up: the groove side)\n\n";
+  md += "| needle | d_a (mm) | this toolkit | experiment | LS-DYNA (paper) | ours - experiment | status | run time |\n";
+  md += "|---|---|---|---|---|---|---|---|\n";
+  for (const NeedleRun& r : runs) {
+    const PaperReferenceNeedle* ref = find_reference(in.reference, r.name);
+    md += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} |\n", r.name, ref ? fmt::format("{:+.2f}", ref->d_a_mm) : "",
+                      fmt_mm(r.deflection_mm), ref ? fmt::format("{:+.2f}", ref->deflection_experiment_mm) : "",
+                      ref ? fmt::format("{:+.2f}", ref->deflection_lsdyna_mm) : "",
+                      ref ? fmt_mm(r.deflection_mm - ref->deflection_experiment_mm) : "",
+                      r.status == "finished" ? "finished" : fmt::format("stopped at {:.1f} mm", r.insertion_mm),
+                      std::isfinite(r.runtime_s) ? fmt::format("{:.1f} min", r.runtime_s / 60) : "n/a");
+  }
+  md += "\n![deflection against insertion](deflection_vs_insertion.png)\n\n![deflection bars](deflection_bars.png)\n\n";
+  md += "## The paper's targets\n\n| target | numbers | verdict |\n|---|---|---|\n";
+  for (const Target& t : targets)
+    md += fmt::format("| {} | {} | {} |\n", t.what, t.numbers, !t.checked ? "not checked (missing run)" : t.met ? "met" : "**not met**");
+  md += "\n## Groove filling\n\n";
+  md += "`groove_fill`: at the end of insertion, in the needle's own frame (each particle pulled back through the needle "
+        "surface nearest it), the groove inside the tissue is cut into 0.05 mm slices along x; in each, the tissue's lowest "
+        "edge (particle centre less half a spacing) inside the groove's section gives the filled share of the groove's depth, "
+        "(rod top - edge) / (rod top - floor), clamped to [0, 1] and 0 where no tissue enters. `groove_fill` is the mean "
+        "over the slices: 1 = tissue down to the floor everywhere, 0 = the groove stays empty. `floor contact` is the share "
+        "of slices where a particle touches the groove floor; `mean gap` the mean height of the tissue's edge above the floor.\n\n";
+  md += "| needle | groove_fill | floor contact | mean gap (mm) | measured sample length (mm) |\n|---|---|---|---|---|\n";
+  for (const NeedleRun& r : runs) {
+    const PaperReferenceNeedle* ref = find_reference(in.reference, r.name);
+    md += fmt::format("| {} | {} | {} | {} | {} |\n", r.name, fmt_mm(r.groove_fill, "{:.3f}"), fmt_mm(r.floor_contact_fraction, "{:.3f}"),
+                      fmt_mm(r.mean_gap_mm, "{:.3f}"), ref ? fmt::format("{:.1f}", ref->sample_length_mm) : "");
+  }
+  md += "\n![groove fill](groove_fill.png)\n\n";
+  md += "## Forces on the facets\n\nThe y force the tissue exerts on each facet (+: pushes the needle up). The bending moment "
+        "that deflects a needle is the balance of these.\n\n![facet forces](facet_forces.png)\n\n";
+  if (tips) md += "## The tips\n\n![the four tips](tips.png)\n\n";
+  md += "## Runs\n\n| needle | folder | coupling steps | max energy-balance error | max penetration (mm) | particles inside at end | "
+        "bonds broken | note |\n|---|---|---|---|---|---|---|---|\n";
+  for (const NeedleRun& r : runs)
+    md += fmt::format("| {} | `{}` | {} | {:.2g} | {:.3f} | {} | {} | {} |\n", r.name, fs::relative(r.folder, dir).string(), r.steps,
+                      r.max_energy_error, r.max_penetration_mm, r.particles_inside, r.bonds_broken, r.reason.empty() ? "" : r.reason);
+  md += "\nEach run folder holds history.csv, facet_forces.csv, summary.json, and needle.pvd / tissue.pvd for ParaView.\n";
+
+  save_text(results.dump(2) + "\n", (dir / "results.json").string());
+  save_text(md, (dir / "report.md").string());
+}
+
+}  // namespace needle

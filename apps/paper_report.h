@@ -1,0 +1,42 @@
+#pragma once
+// The paper's report (`needle paper`): from the run folders of the four needles and the paper's
+// reference table (data/paper/reference.json) it writes, into the report folder,
+//   report.md                    the table of our deflection beside the experiment and LS-DYNA, the
+//                                paper's targets with pass/fail and the numbers, the groove ranking;
+//   results.json                 per needle: deflection_mm, groove_fill, runtime_s and the rest;
+//   deflection_vs_insertion.png  delta against insertion length, all needles, the experiment's end values;
+//   deflection_bars.png          delta of ours, the experiment and LS-DYNA per needle;
+//   groove_fill.png              groove fill per needle beside the measured sample lengths;
+//   facet_forces.png             the y force on each tip facet against insertion, one panel per needle;
+//   tips.png                     the four tips, from above and below.
+// Every file is written whole or not at all.
+#include <string>
+#include <vector>
+
+namespace needle {
+
+struct PaperReferenceNeedle {
+  std::string name;
+  double d_a_mm = 0, deflection_experiment_mm = 0, deflection_lsdyna_mm = 0, sample_length_mm = 0;
+  std::string groove_contact_in_model;
+};
+
+// The needles of the reference file in the paper's order (SB, LMB, AMB, HMB, then any other by name).
+// InputError naming the file and key for a missing file, bad JSON or a missing number.
+std::vector<PaperReferenceNeedle> read_paper_reference(const std::string& path);
+
+struct PaperReportInput {
+  std::string out_dir;                     // the report folder; run folders are out_dir/runs/NAME
+  std::vector<std::string> needles;        // in the order to show
+  std::vector<PaperReferenceNeedle> reference;
+  std::string reference_path;
+  double tissue_E_MPa = 0;
+  std::string tissue_E_source;             // how E was chosen (calibration file, flag or default)
+  std::string command_line;                // to regenerate
+  bool draw_tips = true;
+};
+
+// InputError if a needle's run folder or its summary is missing.
+void write_paper_report(const PaperReportInput& input);
+
+}  // namespace needle

@@ -1,0 +1,70 @@
+#include "plot/bar_chart.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+
+#include "geometry/input_error.h"
+#include "plot/axis_ticks.h"
+
+namespace needle {
+
+RgbImage draw_bar_chart(const BarChart& chart) {
+  double y_min = 0, y_max = 0;  // bars start at zero, so zero is always on the axis
+  bool any = false;
+  for (const BarSeries& s : chart.series)
+    for (double v : s.values)
+      if (std::isfinite(v)) y_min = std::min(y_min, v), y_max = std::max(y_max, v), any = true;
+  NEEDLE_REQUIRE(any, fmt::format("bar chart '{}' has no finite values", chart.title));
+  if (y_max - y_min < 1e-300) y_max += 1;
+  const double step = nice_tick_step(y_max - y_min, 6);
+  y_min = std::floor(y_min / step) * step, y_max = std::ceil(y_max / step) * step;
+  if (y_max - y_min < 1.5 * step) y_max += step;  // room for the value labels
+
+  RgbImage image(chart.width_px, chart.height_px);
+  TextWriter title(20), text(15), small(13);
+  const Rgb ink{30, 30, 30}, grid{225, 225, 225};
+  const int left = 90, right = 20, top = 50, bottom = 60;
+  const int w = chart.width_px - left - right, h = chart.height_px - top - bottom;
+  auto py = [&](double y) { return top + h - (y - y_min) / (y_max - y_min) * h; };
+  title.draw(image, left, 32, chart.title, ink);
+  for (double y = y_min; y <= y_max + 1e-9 * step; y += step) {
+    image.line(left, py(y), left + w, py(y), grid, 1.0);
+    const std::string label = tick_label(y, step);
+    text.draw(image, left - 8 - text.width(label), static_cast<int>(py(y)) + 5, label, ink);
+  }
+  text.draw_vertical(image, 24, top + h / 2 + text.width(chart.y_label) / 2, chart.y_label, ink);
+  const int categories = static_cast<int>(chart.categories.size());
+  const int bars = static_cast<int>(chart.series.size());
+  const double group = static_cast<double>(w) / std::max(1, categories);
+  const double bar = 0.8 * group / std::max(1, bars);
+  for (int c = 0; c < categories; ++c) {
+    const double group_left = left + c * group + 0.1 * group;
+    const std::string& name = chart.categories[static_cast<size_t>(c)];
+    text.draw(image, static_cast<int>(left + (c + 0.5) * group) - text.width(name) / 2, top + h + 24, name, ink);
+    for (int b = 0; b < bars; ++b) {
+      const BarSeries& s = chart.series[static_cast<size_t>(b)];
+      if (static_cast<size_t>(c) >= s.values.size() || !std::isfinite(s.values[static_cast<size_t>(c)])) continue;
+      const double v = s.values[static_cast<size_t>(c)];
+      const int x0 = static_cast<int>(group_left + b * bar + 1), x1 = static_cast<int>(group_left + (b + 1) * bar - 1);
+      const int y0 = static_cast<int>(std::min(py(v), py(0))), y1 = static_cast<int>(std::max(py(v), py(0)));
+      image.fill_rect(x0, y0, x1, std::max(y1, y0 + 1), s.color);
+      const std::string label = fmt::format(fmt::runtime(chart.value_format), v);
+      const int label_y = v >= 0 ? y0 - 4 : y1 + 15;
+      small.draw(image, (x0 + x1) / 2 - small.width(label) / 2, label_y, label, ink);
+    }
+  }
+  image.line(left, top, left, top + h, ink, 1.2);
+  image.line(left, py(0), left + w, py(0), ink, 1.2);
+  // Legend, top left inside the axes.
+  int y = top + 22;
+  for (const BarSeries& s : chart.series) {
+    const int x = left + 12;
+    image.fill_rect(x, y - 12, x + 16, y + 2, s.color);
+    text.draw(image, x + 24, y, s.label, ink);
+    y += 22;
+  }
+  return image;
+}
+
+}  // namespace needle

@@ -1,0 +1,125 @@
+// `needle paper --report-only` over run folders written here with known numbers: the table, the
+// targets' verdicts, results.json and the plots follow from those numbers; missing runs and bad
+// needle names are refused with one message and exit 2.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+
+#include "cli_run.h"
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+using needle_test::run;
+
+namespace {
+
+struct FakeRun {
+  double deflection_mm, groove_fill;
+};
+
+// A run folder as run_insertion writes it, with deflection growing linearly to its end value.
+void write_run(const fs::path& dir, const std::string& name, const FakeRun& r) {
+  const fs::path folder = dir / "runs" / name;
+  fs::create_directories(folder);
+  const json summary = {{"status", "finished"}, {"reason", ""}, {"deflection_mm", r.deflection_mm}, {"insertion_mm", 30.0},
+                        {"runtime_s", 600.0}, {"steps", 8000}, {"max_energy_balance_error", 0.001}, {"max_penetration_mm", 0.01},
+                        {"particles_inside", 0}, {"bonds_broken", 100},
+                        {"groove", {{"groove_fill", r.groove_fill}, {"floor_contact_fraction", r.groove_fill / 2}, {"mean_gap_mm", 0.1}}}};
+  std::ofstream(folder / "summary.json") << summary.dump(2);
+  std::ofstream history(folder / "history.csv");
+  history << "time_ms,insertion_mm,deflection_mm\n";
+  for (int k = 0; k <= 30; ++k) history << k * 0.13 << "," << k << "," << r.deflection_mm * k / 30.0 << "\n";
+  std::ofstream facets(folder / "facet_forces.csv");
+  facets << "time_ms,insertion_mm,top_fy_N,bottom_fy_N\n";
+  for (int k = 0; k <= 30; ++k) facets << k * 0.13 << "," << k << "," << -0.01 * k << "," << 0.005 * k << "\n";
+}
+
+fs::path fresh(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("needle_paper_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+json read_json(const fs::path& path) {
+  std::ifstream in(path);
+  REQUIRE(in.good());
+  return json::parse(in);
+}
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+}  // namespace
+
+TEST_CASE("needle paper --report-only: runs matching the experiment meet every target", "[apps][paper]") {
+  const fs::path dir = fresh("match");
+  // The experiment's deflections, off by at most 0.05 mm; groove fills in the paper's order.
+  const std::map<std::string, FakeRun> runs = {
+      {"SB", {-1.10, 0.90}}, {"LMB", {0.12, 0.95}}, {"AMB", {0.20, 0.40}}, {"HMB", {1.20, 0.10}}};
+  for (const auto& [name, r] : runs) write_run(dir, name, r);
+  const auto result = run("paper --report-only --no-tips --quiet --out " + dir.string(), true);
+  INFO(result.out);
+  REQUIRE(result.exit_code == 0);
+  const json results = read_json(dir / "results.json");
+  for (const auto& [name, r] : runs) {
+    CHECK(results["needles"][name]["deflection_mm"].get<double>() == Approx(r.deflection_mm));
+    CHECK(results["needles"][name]["groove_fill"].get<double>() == Approx(r.groove_fill));
+    CHECK(results["needles"][name]["runtime_s"].get<double>() == Approx(600.0));
+  }
+  // The error against the experiment is ours minus the reference table's value.
+  CHECK(results["needles"]["SB"]["error_vs_experiment_mm"].get<double>() == Approx(-1.10 - (-1.14)));
+  CHECK(results["needles"]["HMB"]["error_vs_experiment_mm"].get<double>() == Approx(1.20 - 1.71));
+  for (const json& t : results["targets"]) {
+    INFO(t.dump());
+    CHECK(t["checked"].get<bool>());
+    CHECK(t["met"].get<bool>());
+  }
+  CHECK(results["targets"].size() == 6);
+  const std::string md = read_text(dir / "report.md");
+  CHECK(md.find("| SB | -0.43 | -1.100 | -1.14 | -1.15 | +0.040 | finished | 10.0 min |") != std::string::npos);
+  CHECK(md.find("not met") == std::string::npos);
+  for (const char* png : {"deflection_vs_insertion.png", "deflection_bars.png", "groove_fill.png", "facet_forces.png"})
+    CHECK(fs::file_size(dir / png) > 1000);
+  CHECK(!fs::exists(dir / "tips.png"));
+}
+
+TEST_CASE("needle paper --report-only: a wrong sign, a large error and a wrong groove ranking are reported as not met", "[apps][paper]") {
+  const fs::path dir = fresh("miss");
+  write_run(dir, "SB", {+0.30, 0.2});   // wrong sign, 1.44 mm off
+  write_run(dir, "LMB", {0.16, 0.9});
+  write_run(dir, "AMB", {0.25, 0.5});
+  write_run(dir, "HMB", {0.50, 0.3});   // 1.21 mm off: worse than LS-DYNA's 0.68
+  const auto result = run("paper --report-only --no-tips --quiet --out " + dir.string(), true);
+  INFO(result.out);
+  REQUIRE(result.exit_code == 0);
+  const json results = read_json(dir / "results.json");
+  std::map<std::string, bool> met;
+  for (const json& t : results["targets"]) met[t["target"].get<std::string>()] = t["met"].get<bool>();
+  CHECK_FALSE(met.at("sign and order: SB < 0 < LMB <~ AMB < HMB (<~: within 0.1 mm)"));
+  CHECK_FALSE(met.at("SB: abs(delta - delta_experiment) <= 0.1 mm"));
+  CHECK(met.at("LMB: abs(delta - delta_experiment) <= 0.1 mm"));
+  CHECK(met.at("AMB: abs(delta - delta_experiment) <= 0.1 mm"));
+  CHECK_FALSE(met.at("HMB: error below LS-DYNA's 0.68 mm"));
+  CHECK_FALSE(met.at("groove fill ranks SB and LMB above AMB above HMB"));
+  CHECK(read_text(dir / "report.md").find("**not met**") != std::string::npos);
+}
+
+TEST_CASE("needle paper refuses missing runs and unknown needles with one message and exit 2", "[apps][paper]") {
+  const fs::path dir = fresh("bad");
+  auto r = run("paper --report-only --no-tips --out " + dir.string(), true);
+  CHECK(r.exit_code == 2);
+  CHECK(r.out.find("no run of SB") != std::string::npos);
+  CHECK(!fs::exists(dir / "report.md"));
+  r = run("paper --needles SB,XYZ --out " + dir.string(), true);
+  CHECK(r.exit_code == 2);
+  CHECK(r.out.find("'XYZ' is not one of") != std::string::npos);
+  r = run("paper --report-only --reference /nonexistent/reference.json --out " + dir.string(), true);
+  CHECK(r.exit_code == 2);
+  CHECK(r.out.find("cannot read the paper's reference table") != std::string::npos);
+}
