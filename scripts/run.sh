@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The main job today: build the paper's four tips, write their reports (JSON), surfaces (STL, glb)
 # and pictures (PNG), their half-model T10 meshes (MSH, VTU), the tissue particles (VTP) and the
-# tissue card's uniaxial test (CSV, PNG, JSON), the needles' stiffness and a needle run folder into out/,
-# and print the speed-against-error benchmarks.
+# tissue card's uniaxial test (CSV, PNG, JSON), the needles' stiffness, a needle run folder and the
+# paper's report (the four coupled insertions) into out/, and print the speed-against-error benchmarks.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh
@@ -24,15 +24,12 @@ done
 ./build/bench/bench_spg | tee out/bench_spg.txt
 ./build/bench/bench_needle | tee out/bench_needle.txt
 ./build/bench/bench_insertion | tee out/bench_insertion.txt
-for preset in SB LMB; do  # the coupled paper insertion, about 15 minutes each on 2 cores
-  # Exit 3 is a run the solver stopped with a reason (summary.json says why; the folder is kept): a
-  # result to read, not a broken main job.
-  code=0
-  ./build/apps/needle run --preset "$preset" --out "out/run_$preset" --overwrite || code=$?
-  if [ "$code" -ne 0 ] && [ "$code" -ne 3 ]; then exit "$code"; fi
-done
+# The paper reproduced: SB, LMB, AMB and HMB on the paper's scene with the tissue E calibrated on SB
+# (data/paper/calibration_sb.json, made by `needle calibrate`; docs/paper.md), about 15 minutes a needle
+# on 2 cores. A run the solver stops is reported as such in the report, not an error of the main job.
+./build/apps/needle paper --calibration data/paper/calibration_sb.json --out out/paper
 echo "results in out/: <preset>.json (report), <preset>.stl, <preset>_half.glb, <preset>.png,"
 echo "  <preset>_half_t10.msh/.vtu + <preset>_mesh.json (T10 mesh and its report), tissue_particles.vtp/.json,"
 echo "  material_test.csv/.png/.json (the tissue card in uniaxial tension), stiffness_<preset>.json (tip compliance"
 echo "  and bending frequencies), sb_quick_run/ (a run folder: SB pushed through the cannula),"
-echo "  run_SB/, run_LMB/ (the coupled insertions: summary.json has deflection_mm), bench_*.txt"
+echo "  paper/ (report.md, results.json, plots and the four run folders: the paper reproduced), bench_*.txt"
