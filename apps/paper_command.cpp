@@ -133,6 +133,7 @@ void paper(const PaperOptions& o) {
   report.reference_path = o.reference;
   report.tissue_E_MPa = scene.tissue.material.E_MPa;
   report.tissue_E_source = E_source;
+  report.calibration_path = o.calibration_file;
   report.command_line = o.command_line;
   report.draw_tips = !o.no_tips;
   write_paper_report(report);

@@ -358,6 +358,28 @@ void write_paper_report(const PaperReportInput& in) {
   md += fmt::format("Tissue E = {:.4g} MPa ({}). Every other number is the paper's (shared/SPEC.md); "
                     "the reference values come from `{}`.\n\n",
                     in.tissue_E_MPa, in.tissue_E_source, in.reference_path);
+  if (!in.calibration_path.empty()) {
+    std::ifstream cal_in(in.calibration_path);
+    json cal;
+    try {
+      cal = json::parse(cal_in);
+    } catch (const json::exception& e) {
+      throw InputError(fmt::format("{}: not valid JSON ({})", in.calibration_path, e.what()));
+    }
+    md += fmt::format("## Calibration of E on {} alone\n\n", cal.value("needle", std::string("SB")));
+    md += fmt::format("Target {:+.2f} mm; each row a full run of the paper's scene (`needle calibrate`). The others are predictions.\n\n",
+                      cal.value("target_deflection_mm", kNaN));
+    md += "| E (MPa) | deflection (mm) | status |\n|---|---|---|\n";
+    for (const json& r : cal.value("runs", json::array()))
+      md += fmt::format("| {:.4g} | {:+.3f} | {} |\n", r.value("E_MPa", kNaN), r.value("deflection_mm", kNaN), r.value("status", std::string()));
+    const json sensitivity = cal.value("sensitivity_mm_per_MPa", json());
+    const json relative = cal.value("relative_sensitivity", json());
+    md += fmt::format("\nChosen: E = {:.4g} MPa ({}). Sensitivity near it: d delta / d E = {} mm per MPa, i.e. {} % of delta per % of E "
+                      "(from the two runs nearest the target).\n\n",
+                      cal.value("tissue_E_MPa", kNaN), cal.value("converged", false) ? "within the tolerance" : "the nearest run; not within the command's tolerance",
+                      sensitivity.is_number() ? fmt::format("{:.3g}", sensitivity.get<double>()) : "n/a",
+                      relative.is_number() ? fmt::format("{:.2f}", relative.get<double>()) : "n/a");
+  }
   md += "## Deflection at the end of insertion (mm, +y up: the groove side)\n\n";
   md += "| needle | d_a (mm) | this toolkit | experiment | LS-DYNA (paper) | ours - experiment | status | run time |\n";
   md += "|---|---|---|---|---|---|---|---|\n";

@@ -32,6 +32,7 @@ struct PaperReportInput {
   std::string reference_path;
   double tissue_E_MPa = 0;
   std::string tissue_E_source;             // how E was chosen (calibration file, flag or default)
+  std::string calibration_path;            // calibration.json of `needle calibrate`, if E came from one
   std::string command_line;                // to regenerate
   bool draw_tips = true;
 };

@@ -63,7 +63,13 @@ TEST_CASE("needle paper --report-only: runs matching the experiment meet every t
   const std::map<std::string, FakeRun> runs = {
       {"SB", {-1.10, 0.90}}, {"LMB", {0.12, 0.95}}, {"AMB", {0.20, 0.40}}, {"HMB", {1.20, 0.10}}};
   for (const auto& [name, r] : runs) write_run(dir, name, r);
-  const auto result = run("paper --report-only --no-tips --quiet --out " + dir.string(), true);
+  // E from a calibration file: the report shows its runs and uses its E.
+  const json calibration = {{"needle", "SB"}, {"target_deflection_mm", -1.14}, {"tissue_E_MPa", 0.05}, {"converged", true},
+                            {"sensitivity_mm_per_MPa", -20.0}, {"relative_sensitivity", 0.9},
+                            {"runs", {{{"E_MPa", 0.1}, {"deflection_mm", -2.0}, {"status", "finished"}},
+                                      {{"E_MPa", 0.05}, {"deflection_mm", -1.10}, {"status", "finished"}}}}};
+  std::ofstream(dir / "calibration.json") << calibration.dump();
+  const auto result = run("paper --report-only --no-tips --quiet --calibration " + (dir / "calibration.json").string() + " --out " + dir.string(), true);
   INFO(result.out);
   REQUIRE(result.exit_code == 0);
   const json results = read_json(dir / "results.json");
@@ -81,9 +87,13 @@ TEST_CASE("needle paper --report-only: runs matching the experiment meet every t
     CHECK(t["met"].get<bool>());
   }
   CHECK(results["targets"].size() == 6);
+  CHECK(results["tissue_E_MPa"].get<double>() == Approx(0.05));
   const std::string md = read_text(dir / "report.md");
   CHECK(md.find("| SB | -0.43 | -1.100 | -1.14 | -1.15 | +0.040 | finished | 10.0 min |") != std::string::npos);
   CHECK(md.find("not met") == std::string::npos);
+  CHECK(md.find("## Calibration of E on SB alone") != std::string::npos);
+  CHECK(md.find("| 0.1 | -2.000 | finished |") != std::string::npos);
+  CHECK(md.find("Chosen: E = 0.05 MPa (within the tolerance)") != std::string::npos);
   for (const char* png : {"deflection_vs_insertion.png", "deflection_bars.png", "groove_fill.png", "facet_forces.png"})
     CHECK(fs::file_size(dir / png) > 1000);
   CHECK(!fs::exists(dir / "tips.png"));
