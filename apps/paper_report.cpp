@@ -338,7 +338,7 @@ void write_paper_report(const PaperReportInput& in) {
                          "mean over the groove's length inside the tissue of the share of the groove's depth (floor to the rod's top) "
                          "that tissue fills, measured in the needle's own frame at the end of insertion (report.md, docs/paper.md)"},
                         {"targets", target_list},
-                        {"reference", in.reference_path}};
+                        {"reference", fs::proximate(in.reference_path).string()}};
 
   // The pictures.
   save_png(deflection_plot(runs, in.reference), (dir / "deflection_vs_insertion.png").string());
@@ -357,7 +357,7 @@ void write_paper_report(const PaperReportInput& in) {
   md += fmt::format("Regenerate: `{}`\n\n", in.command_line);
   md += fmt::format("Tissue E = {:.4g} MPa ({}). Every other number is the paper's (shared/SPEC.md); "
                     "the reference values come from `{}`.\n\n",
-                    in.tissue_E_MPa, in.tissue_E_source, in.reference_path);
+                    in.tissue_E_MPa, in.tissue_E_source, fs::proximate(in.reference_path).string());
   if (!in.calibration_path.empty()) {
     std::ifstream cal_in(in.calibration_path);
     json cal;
