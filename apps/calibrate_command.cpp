@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/insertion_run.h"
+#include "apps/json_file.h"
 #include "apps/scene.h"
 #include "geometry/input_error.h"
 #include "geometry/mesh_io.h"
@@ -27,7 +28,8 @@ namespace {
 
 struct CalibrateOptions {
   std::string preset = "SB", out_dir;
-  double target_mm = std::nan(""), start_E_MPa = std::nan(""), tolerance_mm = 0.05, travel_mm = std::nan(""), spacing_mm = std::nan("");
+  double target_mm = std::nan(""), start_E_MPa = std::nan(""), tolerance_mm = 0.05;
+  SceneOverrides overrides;
   int max_runs = 4, threads = -1;
   bool quiet = false;
 };
@@ -42,31 +44,15 @@ Evaluation evaluate(const Scene& base, double E, const fs::path& runs_dir, const
   scene.tissue.material.E_MPa = E;
   scene.tissue.material.validate();
   const fs::path folder = runs_dir / fmt::format("E_{:.6g}MPa", E);
-  bool reuse = false;
-  {
-    std::ifstream stored(folder / "scene.json"), summary(folder / "summary.json");
-    if (stored.good() && summary.good()) {
-      try {
-        reuse = json::parse(stored) == json::parse(scene_to_json(scene).dump());
-      } catch (const json::exception&) {
-        reuse = false;
-      }
-    }
-  }
-  if (!reuse) {
-    if (!o.quiet) fmt::print("E = {:.6g} MPa: running {} into {}\n", E, o.preset, folder.string());
-    RunOptions run;
-    run.out_dir = folder.string();
-    run.overwrite = true;
-    run.quiet = o.quiet;
-    run.threads = o.threads;
-    run.throw_on_stop = false;
-    run_insertion(scene, run);
-  } else if (!o.quiet) {
-    fmt::print("E = {:.6g} MPa: reusing {}\n", E, folder.string());
-  }
-  std::ifstream in(folder / "summary.json");
-  const json s = json::parse(in);
+  RunOptions run;
+  run.out_dir = folder.string();
+  run.overwrite = true;
+  run.quiet = o.quiet;
+  run.threads = o.threads;
+  run.throw_on_stop = false;
+  const bool reused = run_insertion_unless_done(scene, run);
+  if (!o.quiet) fmt::print("E = {:.6g} MPa: {} {}\n", E, reused ? "reused" : "ran", folder.string());
+  const json s = read_json_file((folder / "summary.json").string(), "run summary");
   Evaluation e;
   e.E_MPa = E;
   e.deflection_mm = s.at("deflection_mm").get<double>();
@@ -85,14 +71,7 @@ void calibrate(const CalibrateOptions& o) {
   NEEDLE_REQUIRE(o.max_runs >= 2 && o.max_runs <= 20, "--max-runs must lie in [2, 20]");
   Scene scene = default_run_scene();
   scene.needle.preset = o.preset;
-  if (!std::isnan(o.travel_mm)) {
-    scene.motion.travel_mm = o.travel_mm;
-    scene.motion.validate("--travel-mm");
-  }
-  if (!std::isnan(o.spacing_mm)) {
-    NEEDLE_REQUIRE(std::isfinite(o.spacing_mm) && o.spacing_mm > 0, "--spacing-mm must be positive");
-    scene.tissue.spacing_mm = o.spacing_mm;
-  }
+  apply_scene_overrides(scene, o.overrides);
   const double start = std::isnan(o.start_E_MPa) ? scene.tissue.material.E_MPa : o.start_E_MPa;
   NEEDLE_REQUIRE(std::isfinite(start) && start > 0, "--start-E-MPa must be positive");
   const fs::path dir(o.out_dir);
@@ -147,14 +126,10 @@ void calibrate(const CalibrateOptions& o) {
   plot.title = fmt::format("Calibration of the tissue's E on {} (target {:+.2f} mm)", o.preset, o.target_mm);
   plot.x_label = "tissue Young's modulus E (MPa)";
   plot.y_label = "deflection at the end (mm)";
-  PlotSeries points{"runs", {}, {}, plot_color(0), false, true};
-  for (const Evaluation& e : sorted) points.x.push_back(e.E_MPa), points.y.push_back(e.deflection_mm);
-  std::vector<size_t> order(points.x.size());
-  for (size_t k = 0; k < order.size(); ++k) order[k] = k;
-  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return points.x[a] < points.x[b]; });
-  PlotSeries line = points;
-  for (size_t k = 0; k < order.size(); ++k) line.x[k] = points.x[order[k]], line.y[k] = points.y[order[k]];
-  line.markers = true;
+  std::vector<Evaluation> by_E = runs;
+  std::sort(by_E.begin(), by_E.end(), [](const auto& a, const auto& b) { return a.E_MPa < b.E_MPa; });
+  PlotSeries line{"runs", {}, {}, plot_color(0), false, true};
+  for (const Evaluation& e : by_E) line.x.push_back(e.E_MPa), line.y.push_back(e.deflection_mm);
   double lo = line.x.front(), hi = line.x.back();
   PlotSeries target{"target", {lo, hi}, {o.target_mm, o.target_mm}, plot_color(1), true, false};
   plot.series = {line, target};
@@ -177,8 +152,8 @@ void add_calibrate_command(CLI::App& app) {
   c->add_option("--start-E-MPa", o->start_E_MPa, "First E to run (default: the card's 0.665)");
   c->add_option("--tolerance-mm", o->tolerance_mm, "Stop when within this of the target (default 0.05)");
   c->add_option("--max-runs", o->max_runs, "Most runs to make (default 4)");
-  c->add_option("--travel-mm", o->travel_mm, "Insertion travel (default 30)");
-  c->add_option("--spacing-mm", o->spacing_mm, "Tissue particle spacing (default 0.4)");
+  c->add_option("--travel-mm", o->overrides.travel_mm, "Insertion travel (default 30)");
+  c->add_option("--spacing-mm", o->overrides.spacing_mm, "Tissue particle spacing (default 0.4)");
   c->add_flag("--quiet", o->quiet, "No progress bars or result lines");
   c->add_option("--threads", o->threads, "Worker threads (default: the scene's; 0: all cores)");
   c->callback([o] { calibrate(*o); });

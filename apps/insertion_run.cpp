@@ -288,4 +288,32 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
   if (status != "finished" && o.throw_on_stop) throw SolverError(reason + fmt::format(" (what was written so far is in {})", o.out_dir));
 }
 
+bool run_insertion_unless_done(const Scene& scene, const RunOptions& options) {
+  const std::filesystem::path folder(options.out_dir);
+  std::ifstream summary(folder / "summary.json"), stored(folder / "scene.json");
+  bool done = false;
+  if (summary.good() && stored.good()) {
+    try {
+      done = json::parse(stored) == json::parse(scene_to_json(scene).dump());
+    } catch (const json::exception&) {
+      done = false;  // an unreadable folder is run again
+    }
+  }
+  if (!done) run_insertion(scene, options);
+  return done;
+}
+
+void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
+  auto given = [](double v, const char* flag) {
+    NEEDLE_REQUIRE(std::isnan(v) || (std::isfinite(v) && v > 0), fmt::format("{} must be a positive number (got {})", flag, v));
+    return !std::isnan(v);
+  };
+  if (given(o.travel_mm, "--travel-mm")) {
+    scene.motion.travel_mm = o.travel_mm;
+    scene.motion.validate("--travel-mm");
+  }
+  if (given(o.spacing_mm, "--spacing-mm")) scene.tissue.spacing_mm = o.spacing_mm;
+  if (given(o.mesh_size_mm, "--mesh-size-mm")) scene.needle.mesh.size_mm = o.mesh_size_mm;
+}
+
 }  // namespace needle

@@ -2,6 +2,7 @@
 // The coupled L-SPG insertion of a scene (tissue.enabled): needle, particles, contact, solve, and the
 // run folder (docs/scenes.md): scene.json, history.csv, facet_forces.csv, summary.json, needle.pvd and
 // tissue.pvd with frames/, run.log. Used by `needle simulate` and `needle run`.
+#include <cmath>
 #include <string>
 
 #include "apps/scene.h"
@@ -22,5 +23,16 @@ Scene default_run_scene();
 // InputError (nothing written) for bad input; SolverError after writing the folder if the solver stopped
 // (unless !throw_on_stop).
 void run_insertion(const Scene& scene, const RunOptions& options);
+
+// Runs the scene into options.out_dir unless that folder already holds a run (summary.json) of exactly
+// this scene (scene.json); true if it reused one. An interrupted `paper` or `calibrate` resumes this way.
+bool run_insertion_unless_done(const Scene& scene, const RunOptions& options);
+
+// The scene flags `needle run`, `paper` and `calibrate` share; NaN keeps the scene's value.
+struct SceneOverrides {
+  double travel_mm = std::nan(""), spacing_mm = std::nan(""), mesh_size_mm = std::nan("");
+};
+// InputError naming the flag for a value that is not a positive number.
+void apply_scene_overrides(Scene& scene, const SceneOverrides& overrides);
 
 }  // namespace needle

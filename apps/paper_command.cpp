@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "apps/insertion_run.h"
+#include "apps/json_file.h"
 #include "apps/paper_report.h"
 #include "apps/scene.h"
 #include "geometry/input_error.h"
@@ -28,7 +29,8 @@ namespace {
 struct PaperOptions {
   std::string out_dir, needles = "SB,LMB,AMB,HMB", reference = std::string(NEEDLE_DATA_DIR) + "/paper/reference.json";
   std::string calibration_file;
-  double tissue_E_MPa = std::nan(""), travel_mm = std::nan(""), spacing_mm = std::nan(""), mesh_size_mm = std::nan("");
+  double tissue_E_MPa = std::nan("");
+  SceneOverrides overrides;
   bool report_only = false, rerun = false, no_tips = false, quiet = false;
   int threads = -1;
   std::string command_line;
@@ -48,28 +50,10 @@ std::vector<std::string> split_names(const std::string& list) {
 
 // E from a calibration file written by `needle calibrate` (its tissue_E_MPa).
 double calibrated_E(const std::string& path) {
-  std::ifstream in(path);
-  NEEDLE_REQUIRE(in.good(), fmt::format("cannot read the calibration '{}'", path));
-  json j;
-  try {
-    j = json::parse(in);
-  } catch (const json::exception& e) {
-    throw InputError(fmt::format("{}: not valid JSON ({})", path, e.what()));
-  }
+  const json j = read_json_file(path, "calibration");
   NEEDLE_REQUIRE(j.contains("tissue_E_MPa") && j["tissue_E_MPa"].is_number() && j["tissue_E_MPa"].get<double>() > 0,
                  fmt::format("{}: tissue_E_MPa must be a positive number", path));
   return j["tissue_E_MPa"].get<double>();
-}
-
-// True if the folder holds a run (summary.json) of exactly this scene.
-bool has_run_of(const fs::path& folder, const Scene& scene) {
-  std::ifstream summary(folder / "summary.json"), stored(folder / "scene.json");
-  if (!summary.good() || !stored.good()) return false;
-  try {
-    return json::parse(stored) == json::parse(scene_to_json(scene).dump());
-  } catch (const json::exception&) {
-    return false;
-  }
 }
 
 void paper(const PaperOptions& o) {
@@ -87,16 +71,7 @@ void paper(const PaperOptions& o) {
     E_source = "given with --tissue-E-MPa";
   }
   scene.tissue.material.validate();
-  auto positive = [](double v, const char* flag) {
-    NEEDLE_REQUIRE(std::isnan(v) || (std::isfinite(v) && v > 0), fmt::format("{} must be a positive number (got {})", flag, v));
-    return !std::isnan(v);
-  };
-  if (positive(o.travel_mm, "--travel-mm")) {
-    scene.motion.travel_mm = o.travel_mm;
-    scene.motion.validate("--travel-mm");
-  }
-  if (positive(o.spacing_mm, "--spacing-mm")) scene.tissue.spacing_mm = o.spacing_mm;
-  if (positive(o.mesh_size_mm, "--mesh-size-mm")) scene.needle.mesh.size_mm = o.mesh_size_mm;
+  apply_scene_overrides(scene, o.overrides);
 
   const fs::path dir(o.out_dir);
   const fs::path parent = fs::absolute(dir).parent_path();
@@ -106,24 +81,19 @@ void paper(const PaperOptions& o) {
     fs::create_directories(dir / "runs");
     for (const std::string& name : needles) {
       Scene s = scene;
-      s.needle.preset = name;
-      s.needle.recipe_file.clear();
-      s.needle.mesh_file.clear();
-      s.needle.d_a_mm = std::nan("");
-      s.needle.plain_rod = false;
+      s.needle.preset = name;  // the run scene has no other needle source
       const fs::path folder = dir / "runs" / name;
-      if (!o.rerun && has_run_of(folder, s)) {
-        if (!o.quiet) fmt::print("{}: reusing the run in {}\n", name, folder.string());
-        continue;
-      }
-      if (!o.quiet) fmt::print("{}: running the paper's insertion into {}\n", name, folder.string());
       RunOptions run;
       run.out_dir = folder.string();
       run.overwrite = true;
       run.quiet = o.quiet;
       run.threads = o.threads;
       run.throw_on_stop = false;  // a stopped run is reported as such, with what it reached
-      run_insertion(s, run);
+      if (o.rerun) {
+        run_insertion(s, run);
+      } else if (run_insertion_unless_done(s, run) && !o.quiet) {
+        fmt::print("{}: reused the run in {}\n", name, folder.string());
+      }
     }
   }
   PaperReportInput report;
@@ -151,9 +121,9 @@ void add_paper_command(CLI::App& app) {
   c->add_option("--tissue-E-MPa", o->tissue_E_MPa, "Tissue Young's modulus (default: the card's 0.665 MPa)");
   c->add_option("--calibration", o->calibration_file, "calibration.json from `needle calibrate` (its tissue_E_MPa)");
   c->add_option("--reference", o->reference, "The paper's reference table (default data/paper/reference.json)");
-  c->add_option("--travel-mm", o->travel_mm, "Insertion travel (default 30; shorter for a quick look)");
-  c->add_option("--spacing-mm", o->spacing_mm, "Tissue particle spacing (default 0.4)");
-  c->add_option("--mesh-size-mm", o->mesh_size_mm, "Needle mesh size (run default 0.4)");
+  c->add_option("--travel-mm", o->overrides.travel_mm, "Insertion travel (default 30; shorter for a quick look)");
+  c->add_option("--spacing-mm", o->overrides.spacing_mm, "Tissue particle spacing (default 0.4)");
+  c->add_option("--mesh-size-mm", o->overrides.mesh_size_mm, "Needle mesh size (run default 0.4)");
   c->add_flag("--report-only", o->report_only, "Only rewrite the report from the run folders already in OUT/runs");
   c->add_flag("--rerun", o->rerun, "Run every needle again even if OUT/runs holds a run of the same scene");
   c->add_flag("--no-tips", o->no_tips, "Skip the tip pictures (they need the CAD booleans, a few seconds each)");
@@ -167,9 +137,9 @@ void add_paper_command(CLI::App& app) {
     if (c->count("--tissue-E-MPa")) line += fmt::format(" --tissue-E-MPa {}", o->tissue_E_MPa);
     if (c->count("--calibration")) line += " --calibration " + o->calibration_file;
     if (c->count("--reference")) line += " --reference " + o->reference;
-    if (c->count("--travel-mm")) line += fmt::format(" --travel-mm {}", o->travel_mm);
-    if (c->count("--spacing-mm")) line += fmt::format(" --spacing-mm {}", o->spacing_mm);
-    if (c->count("--mesh-size-mm")) line += fmt::format(" --mesh-size-mm {}", o->mesh_size_mm);
+    if (c->count("--travel-mm")) line += fmt::format(" --travel-mm {}", o->overrides.travel_mm);
+    if (c->count("--spacing-mm")) line += fmt::format(" --spacing-mm {}", o->overrides.spacing_mm);
+    if (c->count("--mesh-size-mm")) line += fmt::format(" --mesh-size-mm {}", o->overrides.mesh_size_mm);
     paper(*o);
   });
 }

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/csv_table.h"
+#include "apps/json_file.h"
 #include "geometry/cad_solid.h"
 #include "geometry/grinding_recipe.h"
 #include "geometry/input_error.h"
@@ -47,14 +48,8 @@ NeedleRun read_run(const std::string& out_dir, const std::string& name) {
   r.name = name;
   r.folder = (fs::path(out_dir) / "runs" / name).string();
   const std::string summary_path = (fs::path(r.folder) / "summary.json").string();
-  std::ifstream in(summary_path);
-  NEEDLE_REQUIRE(in.good(), fmt::format("no run of {}: '{}' is missing (run `needle paper` without --report-only first)", name, summary_path));
-  json s;
-  try {
-    s = json::parse(in);
-  } catch (const json::exception& e) {
-    throw InputError(fmt::format("{}: not valid JSON ({})", summary_path, e.what()));
-  }
+  NEEDLE_REQUIRE(fs::exists(summary_path), fmt::format("no run of {}: '{}' is missing (run `needle paper` without --report-only first)", name, summary_path));
+  const json s = read_json_file(summary_path, "run summary");
   r.status = s.value("status", std::string("unknown"));
   r.reason = s.value("reason", std::string());
   r.deflection_mm = number_or_nan(s, "deflection_mm");
@@ -267,14 +262,7 @@ bool is_paper_needle(const std::string& name) { return std::find(kPaperOrder.beg
 }  // namespace
 
 std::vector<PaperReferenceNeedle> read_paper_reference(const std::string& path) {
-  std::ifstream in(path);
-  NEEDLE_REQUIRE(in.good(), fmt::format("cannot read the paper's reference table '{}'", path));
-  json j;
-  try {
-    j = json::parse(in);
-  } catch (const json::exception& e) {
-    throw InputError(fmt::format("{}: not valid JSON ({})", path, e.what()));
-  }
+  const json j = read_json_file(path, "paper's reference table");
   NEEDLE_REQUIRE(j.contains("needles") && j["needles"].is_object(), fmt::format("{}: no 'needles' object", path));
   std::vector<PaperReferenceNeedle> out;
   for (const auto& [name, v] : j["needles"].items()) {
@@ -359,13 +347,7 @@ void write_paper_report(const PaperReportInput& in) {
                     "the reference values come from `{}`.\n\n",
                     in.tissue_E_MPa, in.tissue_E_source, fs::proximate(in.reference_path).string());
   if (!in.calibration_path.empty()) {
-    std::ifstream cal_in(in.calibration_path);
-    json cal;
-    try {
-      cal = json::parse(cal_in);
-    } catch (const json::exception& e) {
-      throw InputError(fmt::format("{}: not valid JSON ({})", in.calibration_path, e.what()));
-    }
+    const json cal = read_json_file(in.calibration_path, "calibration");
     md += fmt::format("## Calibration of E on {} alone\n\n", cal.value("needle", std::string("SB")));
     md += fmt::format("Target {:+.2f} mm; each row a full run of the paper's scene (`needle calibrate`). The others are predictions.\n\n",
                       cal.value("target_deflection_mm", kNaN));

@@ -16,7 +16,8 @@ namespace {
 struct RunCommandOptions {
   std::string preset, recipe, scene_file;
   double d_a_mm = std::nan("");
-  double travel_mm = std::nan(""), spacing_mm = std::nan(""), mesh_size_mm = std::nan(""), mass_scaling_dt_ms = std::nan("");
+  SceneOverrides overrides;
+  double mass_scaling_dt_ms = std::nan("");
   double tissue_E_MPa = std::nan("");
   int frames = -1;
   bool no_subcycling = false, rigid = false;
@@ -37,20 +38,12 @@ void run(const RunCommandOptions& o) {
     n.mesh_file.clear();
     n.plain_rod = false;
   }
-  auto positive = [](double v, const char* flag) {
-    NEEDLE_REQUIRE(std::isnan(v) || (std::isfinite(v) && v > 0), fmt::format("{} must be a positive number (got {})", flag, v));
-    return !std::isnan(v);
-  };
-  if (positive(o.travel_mm, "--travel-mm")) {
-    scene.motion.travel_mm = o.travel_mm;
-    scene.motion.validate("--travel-mm");
-  }
-  if (positive(o.spacing_mm, "--spacing-mm")) scene.tissue.spacing_mm = o.spacing_mm;
-  if (positive(o.mesh_size_mm, "--mesh-size-mm")) scene.needle.mesh.size_mm = o.mesh_size_mm;
+  apply_scene_overrides(scene, o.overrides);
   NEEDLE_REQUIRE(std::isnan(o.mass_scaling_dt_ms) || (std::isfinite(o.mass_scaling_dt_ms) && o.mass_scaling_dt_ms >= 0),
                  "--mass-scaling-dt-ms must be zero (off) or positive");
   if (!std::isnan(o.mass_scaling_dt_ms)) scene.solver.mass_scaling_dt_ms = o.mass_scaling_dt_ms;
-  if (positive(o.tissue_E_MPa, "--tissue-E-MPa")) {
+  if (!std::isnan(o.tissue_E_MPa)) {
+    NEEDLE_REQUIRE(std::isfinite(o.tissue_E_MPa) && o.tissue_E_MPa > 0, fmt::format("--tissue-E-MPa must be a positive number (got {})", o.tissue_E_MPa));
     scene.tissue.material.E_MPa = o.tissue_E_MPa;
     scene.tissue.material.validate();
   }
@@ -71,9 +64,9 @@ void add_run_command(CLI::App& app) {
   c->add_option("--recipe", o->recipe, "Grinding recipe (JSON)");
   c->add_option("--scene", o->scene_file, "Scene file (JSON) instead of the run defaults; tissue is switched on");
   c->add_option("--out", o->run.out_dir, "Run folder to create")->required();
-  c->add_option("--travel-mm", o->travel_mm, "Insertion travel (default 30)");
-  c->add_option("--spacing-mm", o->spacing_mm, "Tissue particle spacing (default 0.4)");
-  c->add_option("--mesh-size-mm", o->mesh_size_mm, "Needle mesh size over the tip and groove (run default 0.4; paper 0.2)");
+  c->add_option("--travel-mm", o->overrides.travel_mm, "Insertion travel (default 30)");
+  c->add_option("--spacing-mm", o->overrides.spacing_mm, "Tissue particle spacing (default 0.4)");
+  c->add_option("--mesh-size-mm", o->overrides.mesh_size_mm, "Needle mesh size over the tip and groove (run default 0.4; paper 0.2)");
   c->add_option("--mass-scaling-dt-ms", o->mass_scaling_dt_ms, "Needle selective mass scaling target step (run default 5e-6; 0: off)");
   c->add_option("--tissue-E-MPa", o->tissue_E_MPa, "Tissue Young's modulus (the calibrated parameter; default 0.665)");
   c->add_option("--frames", o->frames, "ParaView frames over the run (default 20; 0: none)");

@@ -263,9 +263,6 @@ void NeedleTissueContact::needle_forces(const Eigen::MatrixX3d& needle_x, const 
   }
   report_.friction_power_mW = friction_power;
   if (dt > 0) friction_dissipation_mJ_ += 0.5 * dt * (last_friction_power_mW_ + friction_power);
-  contacts_.clear();
-  for (size_t k = 0; k < pairs_.size(); ++k)
-    if (pair_force_[k].squaredNorm() > 0) contacts_.emplace_back(pairs_[k].particle, pairs_[k].triangle);
   if (tau == 0) {  // the state at a step's start (t = 0, before any step): the particles get the forces as they are
     previous_force_.clear();
     previous_particles_.clear();
@@ -274,6 +271,7 @@ void NeedleTissueContact::needle_forces(const Eigen::MatrixX3d& needle_x, const 
         previous_force_.push_back(pair_force_[k]);
         previous_particles_.push_back(pairs_[k].particle);
       }
+    record_contacts();
   }
   last_friction_power_mW_ = friction_power;
   last_eval_ms_ = time_ms;
@@ -294,7 +292,14 @@ void NeedleTissueContact::end_step(std::vector<Vec3d>& particle_force) {
     previous_force_.push_back(f);
     previous_particles_.push_back(pairs_[k].particle);
   }
+  record_contacts();
   last_particle_forces(particle_force);
+}
+
+void NeedleTissueContact::record_contacts() {
+  contacts_.clear();
+  for (size_t k = 0; k < pairs_.size(); ++k)
+    if (pair_force_[k].squaredNorm() > 0) contacts_.emplace_back(pairs_[k].particle, pairs_[k].triangle);
 }
 
 void NeedleTissueContact::last_particle_forces(std::vector<Vec3d>& particle_force) const {

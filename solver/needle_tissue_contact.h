@@ -110,9 +110,9 @@ class NeedleTissueContact {
 
   // The contact's own stable step for a particle alone: min over particles of 2 sqrt(m_i / k_i).
   double stable_time_step_ms() const { return stable_dt_ms_; }
-  // Per particle: 1 if in contact at the last evaluation.
+  // Per particle: 1 if in contact at the last step's end.
   std::vector<std::uint8_t> in_contact() const;
-  // The contacts of the last evaluation: particle and surface triangle (-1: a node fallback).
+  // The contacts at the last step's end (or at t = 0): particle and surface triangle (-1: a node fallback).
   const std::vector<std::pair<int, int>>& contacts() const { return contacts_; }
   // Points pulled back to the needle's reference configuration by the displacement of the nearest
   // surface node (as the contact does); NaN where no surface node lies within the search radius.
@@ -141,6 +141,7 @@ class NeedleTissueContact {
   // Level-set query of every particle at positions x (reach: how far outside the skin still counts as near).
   void probe(const std::vector<Vec3d>& x, const Eigen::MatrixX3d& needle_x, const std::vector<double>& reach);
   Eigen::Vector3d surface_point(const Pair& pair, const Eigen::MatrixX3d& needle) const;
+  void record_contacts();  // contacts_ from the last evaluation (at a step's end, not at every substep)
 
   const ContactSurface& surface_;
   ContactOptions options_;
@@ -155,7 +156,7 @@ class NeedleTissueContact {
   std::vector<Eigen::Vector3d> pair_dissipative_impulse_;     // per pair, damper + friction integrated over the step
   std::vector<Eigen::Vector3d> previous_force_;               // the particles' forces of the last step's end ...
   std::vector<int> previous_particles_;                       // ... and their particles
-  std::vector<std::pair<int, int>> contacts_;                 // (particle, triangle) in contact at the last evaluation
+  std::vector<std::pair<int, int>> contacts_;                 // (particle, triangle) in contact at the last step's end
   double step_start_ms_ = 0, step_dt_ms_ = 0, last_eval_ms_ = 0, last_friction_power_mW_ = 0, friction_dissipation_mJ_ = 0, relinearisation_energy_mJ_ = 0;
   ContactReport report_;
   // Grid of the current surface nodes (rebuilt per query): sorted (cell, node).

@@ -211,6 +211,7 @@ ForceReport SpgTissue::compute_forces(double dt_ms) {
 
 std::int64_t SpgTissue::break_bonds() {
   const BondFailure& rule = options_.bond_failure;
+  const double rupture_stretch = std::exp(rule.strain);  // the bond's own stretch at the failure strain
   std::vector<std::uint8_t> breaking(bonds_.bonds.size(), 0);
   parallel_for(static_cast<std::int64_t>(bonds_.bonds.size()), [&](std::int64_t begin, std::int64_t end) {
     for (std::int64_t b = begin; b < end; ++b) {
@@ -231,7 +232,7 @@ std::int64_t SpgTissue::break_bonds() {
         // a support carry almost nothing, so a crack opening past them never raises the particles'
         // strain; measured along the bond they fail with the material around them.
         const double reference = (p_.reference_mm[i] - p_.reference_mm[j]).norm();
-        fails = (p_.position_mm[i] - p_.position_mm[j]).norm() > std::exp(rule.strain) * reference;
+        fails = (p_.position_mm[i] - p_.position_mm[j]).norm() > rupture_stretch * reference;
       }
       if (rule.stretch_ratio > 0) {
         const double reference = (p_.reference_mm[i] - p_.reference_mm[j]).norm();

@@ -1,0 +1,20 @@
+#include "apps/json_file.h"
+
+#include <fmt/format.h>
+#include <fstream>
+
+#include "geometry/input_error.h"
+
+namespace needle {
+
+nlohmann::json read_json_file(const std::string& path, const std::string& what) {
+  std::ifstream in(path);
+  NEEDLE_REQUIRE(in.good(), fmt::format("cannot read the {} '{}'", what, path));
+  try {
+    return nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(fmt::format("{}: not valid JSON ({})", path, e.what()));
+  }
+}
+
+}  // namespace needle
