@@ -18,7 +18,8 @@ struct Bond {
 
 struct BondNetwork {
   std::vector<Bond> bonds;
-  std::int64_t broken_count = 0;
+  std::int64_t broken_count = 0;  // all broken bonds: by the failure criterion, dead, or cut
+  std::int64_t cut_count = 0;     // of those, the ones cut by a body through them (SpgTissue::cut_bonds)
 };
 
 BondNetwork build_bond_network(const RkShapeFunctions& rk);

@@ -8,7 +8,9 @@
 //   1. the needle takes its own steps from t to t + Dt under the contact force -C(t), held constant;
 //   2. the tissue takes one velocity-Verlet step of Dt; after its drift the contact C(t + Dt) is computed
 //      from both bodies' new positions and acts on the particles at once (so the tissue's side of the
-//      stiff penalty is integrated exactly as a force of its own) and on the needle from the next step.
+//      stiff penalty is integrated exactly as a force of its own) and on the needle from the next step;
+//   3. the bonds the needle's body now passes through are cut (needle_bond_cut.h; ContactOptions::cuts_bonds),
+//      as the failure criterion breaks its bonds after a force evaluation: from the next step on.
 // Each step, the needle receives -C(t) Dt and the tissue (C(t) + C(t + Dt)) Dt / 2: momentum is exchanged
 // exactly up to a half-step lag that never accumulates (it telescopes to Dt/2 |C(end) - C(0)|). The lag is
 // stable because the steel's response to a force within one tissue step is tiny next to the contact's
@@ -26,6 +28,7 @@
 
 #include "solver/explicit_dynamics.h"
 #include "solver/needle_dynamics.h"
+#include "solver/needle_bond_cut.h"
 #include "solver/needle_tissue_contact.h"
 
 namespace needle {
@@ -73,6 +76,7 @@ class LspgInsertion {
   int max_particles_inside() const { return max_inside_; }
   double max_depth_mm() const { return max_depth_; }
   long bonds_broken() const { return static_cast<long>(tissue_.bonds().broken_count); }
+  long bonds_cut_by_needle() const { return static_cast<long>(tissue_.bonds().cut_count); }
   // Momenta (g mm/ms) and what the drive put in.
   Eigen::Vector3d tissue_momentum() const;
   Eigen::Vector3d needle_momentum() const { return needle_.momentum(); }
@@ -88,6 +92,8 @@ class LspgInsertion {
   CouplingOptions options_;
   TissueDynamics tissue_dynamics_;
   NeedleTissueContact contact_;
+  NeedleBondCut bond_cut_;
+  bool cuts_bonds_ = true;
   InsertionEnergy energy_;
   bool in_step_ = false;
   double step_start_ms_ = 0, step_dt_ms_ = 0, last_dt_ms_ = 0, max_energy_error_ = 0, max_depth_ = 0;

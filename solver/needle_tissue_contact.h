@@ -51,6 +51,8 @@ struct ContactOptions {
   double damping_ratio = 0.2;     // normal viscous damping, fraction of critical 2 sqrt(k m_r) (LS-DYNA's VDC)
   double needle_stiffness_scale = 0.1;  // cap of k on the needle's side, x m_c / dt_needle^2
   double voxel_mm = 0.02;         // the needle level set's resolution
+  bool cuts_bonds = true;         // the needle breaks the tissue bonds its body passes through (needle_bond_cut.h);
+                                  // false: only the tissue's failure criterion separates particles
   void validate(const std::string& where = "contact") const;  // InputError naming the bad field
 };
 

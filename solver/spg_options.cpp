@@ -16,6 +16,8 @@ void SpgOptions::validate() const {
   NEEDLE_REQUIRE(stabilization != Stabilization::filter || stabilization_coefficient <= 1.0,
                  "SPG filter coefficient must lie in [0, 1]");
   NEEDLE_REQUIRE(smoothing_interval_steps >= 1, "SPG smoothing_interval_steps must be >= 1");
+  NEEDLE_REQUIRE(std::isfinite(crack_face_min_volume_ratio) && crack_face_min_volume_ratio >= 0 && crack_face_min_volume_ratio < 1,
+                 fmt::format("SPG crack_face_min_volume_ratio must lie in [0, 1) (got {})", crack_face_min_volume_ratio));
   NEEDLE_REQUIRE(std::isfinite(bond_failure.strain) && bond_failure.strain > 0,
                  fmt::format("bond failure strain must be positive (got {})", bond_failure.strain));
   NEEDLE_REQUIRE(std::isfinite(bond_failure.stretch_ratio) && (bond_failure.stretch_ratio == 0 || bond_failure.stretch_ratio > 1),

@@ -140,22 +140,25 @@ ForceReport SpgTissue::compute_forces(double dt_ms) {
       }
       const Mat3d F = gather_gradient(rk_, i, p_.position_mm);
       const double J = F.determinant();
-      if (!(J > kMinJacobian) || !F.allFinite()) {
+      const bool collapsed = !(J > kMinJacobian) || !F.allFinite();
+      if (collapsed || J < options_.crack_face_min_volume_ratio) {
         // A particle on a crack face (some bonds cut) whose remaining support collapses stops being an
         // integration point: it keeps its mass and moves on as a free particle. Intact material that
-        // inverts is a blow-up.
+        // inverts is a blow-up; intact material merely compressed that far stays.
         bool on_crack = false;
         for (std::int64_t e = rk_.offset[s]; e < rk_.offset[s + 1] && !on_crack; ++e) on_crack = rk_.cut[static_cast<size_t>(e)];
-        if (!on_crack) {
+        if (collapsed && !on_crack) {
           status[s] = kFailed;
           continue;
         }
-        status[s] = kDetached;
-        piola_volume_[s].setZero();
-        p_.stress_MPa[s].setZero();
-        p_.elastic_left_cauchy_green[s].setIdentity();
-        p_.effective_strain[s] = p_.plastic_strain[s];
-        continue;
+        if (on_crack) {
+          status[s] = kDetached;
+          piola_volume_[s].setZero();
+          p_.stress_MPa[s].setZero();
+          p_.elastic_left_cauchy_green[s].setIdentity();
+          p_.effective_strain[s] = p_.plastic_strain[s];
+          continue;
+        }
       }
       if (dt_ms > 0) {
         const StressUpdate u = update_stress(material_, {p_.elastic_left_cauchy_green[s], p_.plastic_strain[s]},
@@ -241,6 +244,19 @@ std::int64_t SpgTissue::break_bonds() {
       breaking[static_cast<size_t>(b)] = fails;
     }
   });
+  return separate(breaking);
+}
+
+std::int64_t SpgTissue::cut_bonds(const std::vector<std::int64_t>& bond_indices) {
+  std::vector<std::uint8_t> breaking(bonds_.bonds.size(), 0);
+  for (std::int64_t b : bond_indices)
+    if (!bonds_.bonds.at(static_cast<size_t>(b)).broken) breaking[static_cast<size_t>(b)] = 1;
+  const std::int64_t count = separate(breaking);
+  bonds_.cut_count += count;
+  return count;
+}
+
+std::int64_t SpgTissue::separate(const std::vector<std::uint8_t>& breaking) {
   std::vector<std::int64_t> rows;
   for (size_t b = 0; b < breaking.size(); ++b) {
     if (!breaking[b]) continue;

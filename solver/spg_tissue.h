@@ -59,6 +59,11 @@ class SpgTissue {
   // SolverError on an inverted or non-finite particle.
   ForceReport compute_forces(double dt_ms);
 
+  // Breaks the given bonds (indices into bonds(); already broken ones are skipped) whatever the strains
+  // say, e.g. where the needle's body separates their particles (needle_bond_cut.h), and rebuilds their
+  // rows as break_bonds does. Returns how many it broke; they count in bonds().broken_count and cut_count.
+  std::int64_t cut_bonds(const std::vector<std::int64_t>& bond_indices);
+
   // The smallest current spacing over the dilatational wave speed (with stabilization stiffness), x cfl.
   double stable_time_step_ms() const;
 
@@ -81,6 +86,9 @@ class SpgTissue {
   void apply_filter();
   void reinitialize_kernel();
   std::int64_t break_bonds();
+  // Marks the bonds flagged in breaking (1: cut, 2: dead, no live row changes) broken and rebuilds the rows
+  // of their particles; the count of those newly broken.
+  std::int64_t separate(const std::vector<std::uint8_t>& breaking);
   void refresh_reference_matrix();
 
   TissueParticles p_;

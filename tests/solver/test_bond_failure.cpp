@@ -80,15 +80,22 @@ TEST_CASE("A notched bar pulled apart separates at the bond-failure strain", "[s
   CHECK(first_break_max_bond_strain > 0.8 * options.bond_failure.strain);
   CHECK(first_break_max_bond_strain <= 1.2 * options.bond_failure.strain);
   // Every broken bond met the criterion (plastic strain only grows; the effective strain falls back by its
-  // elastic part when the pieces unload, so it is checked at the first break above only).
-  std::int64_t broken = 0;
+  // elastic part when the pieces unload, so it is checked at the first break above only). A bond between
+  // two detached crack-face particles (SpgOptions::crack_face_min_volume_ratio) is dead, not failed.
+  std::int64_t broken = 0, dead = 0;
+  const std::vector<std::uint8_t>& valid = tissue.shape_functions().valid;
   for (const Bond& b : tissue.bonds().bonds) {
     if (!b.broken) continue;
     ++broken;
+    if (!valid[static_cast<size_t>(b.i)] && !valid[static_cast<size_t>(b.j)]) {
+      ++dead;
+      continue;
+    }
     if (plastic_measure)
       CHECK(0.5 * (p.plastic_strain[static_cast<size_t>(b.i)] + p.plastic_strain[static_cast<size_t>(b.j)]) > options.bond_failure.strain);
   }
   CHECK(broken == tissue.bonds().broken_count);
+  INFO(dead << " of the broken bonds are dead");
   // The crack runs through the notch plane: every broken bond straddles or touches x = 6 +- 1 mm.
   for (const Bond& b : tissue.bonds().bonds)
     if (b.broken) CHECK(std::abs(0.5 * (p.reference_mm[static_cast<size_t>(b.i)].x() + p.reference_mm[static_cast<size_t>(b.j)].x()) - 6.0) < 1.5);
@@ -101,4 +108,47 @@ TEST_CASE("A notched bar pulled apart separates at the bond-failure strain", "[s
   CHECK(left_mass > 0.3 * total_mass);
   CHECK(right_mass > 0.3 * total_mass);
   for (const auto& x : p.position_mm) CHECK(x.allFinite());
+}
+
+TEST_CASE("Cut bonds separate their particles; squeezed crack-face particles detach, intact ones do not", "[solver][failure]") {
+  // Cut every bond across the plane x = 1.1 of a 2 mm cube (cut_bonds, as the needle does), then squeeze
+  // the whole block to a fifth of its volume. The particles with a cut bond are on a crack face: below
+  // crack_face_min_volume_ratio they stop being integration points. The others are intact and stay.
+  const ParticleSet set = needle_test::free_box({0, 0, 0}, {2, 2, 2}, 0.2);
+  for (double threshold : {0.25, 0.1}) {
+    SpgOptions options;
+    options.crack_face_min_volume_ratio = threshold;
+    SpgTissue tissue(set, TissueMaterial{}, options);
+    std::vector<std::int64_t> across;
+    std::vector<std::uint8_t> on_face(static_cast<size_t>(tissue.particles().size()), 0);
+    for (size_t b = 0; b < tissue.bonds().bonds.size(); ++b) {
+      const Bond& bond = tissue.bonds().bonds[b];
+      const double xi = tissue.particles().position_mm[static_cast<size_t>(bond.i)].x(), xj = tissue.particles().position_mm[static_cast<size_t>(bond.j)].x();
+      if ((xi - 1.1) * (xj - 1.1) < 0) {
+        across.push_back(static_cast<std::int64_t>(b));
+        on_face[static_cast<size_t>(bond.i)] = on_face[static_cast<size_t>(bond.j)] = 1;
+      }
+    }
+    REQUIRE(!across.empty());
+    CHECK(tissue.cut_bonds(across) == static_cast<std::int64_t>(across.size()));
+    CHECK(tissue.bonds().cut_count == static_cast<std::int64_t>(across.size()));
+    CHECK(tissue.bonds().broken_count == static_cast<std::int64_t>(across.size()));
+    CHECK(tissue.cut_bonds(across) == 0);  // cut once
+    // The two halves no longer share a bond.
+    const std::vector<int> root = components(tissue);
+    CHECK(root.front() != root.back());
+
+    const double stretch = std::cbrt(0.2);  // det F = 0.2
+    for (Vec3d& x : tissue.particles().position_mm) x *= stretch;
+    const ForceReport report = tissue.compute_forces(0.0);
+    const std::int64_t face = std::count(on_face.begin(), on_face.end(), std::uint8_t{1});
+    INFO("threshold " << threshold << ": " << face << " crack-face particles of " << tissue.particles().size());
+    if (threshold > 0.2) {
+      CHECK(report.particles_detached_now == face);
+      CHECK(tissue.valid_integration_points() == tissue.particles().size() - face);
+    } else {
+      CHECK(report.particles_detached_now == 0);
+      CHECK(tissue.valid_integration_points() == tissue.particles().size());
+    }
+  }
 }

@@ -1,0 +1,125 @@
+// The needle cuts the bonds its body passes through (solver/needle_bond_cut.h): segment crossings of a
+// meshed rod against the cylinder's closed form, on the full and on the half model, and the bonds of a
+// particle lattice the rod lies in against an independent point-sampling of the cylinder.
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "mesher/needle_mesher.h"
+#include "mesher/particle_lattice.h"
+#include "solver/needle_bond_cut.h"
+#include "solver/spg_tissue.h"
+
+using namespace needle;
+
+namespace {
+
+constexpr double kRadius = 0.5, kLength = 4.0;  // plain rod: x in [-4, 0], axis y = z = 0
+
+TetMesh rod_mesh(bool half) {
+  NeedleMeshOptions o;
+  o.order = 1;
+  o.size_mm = 0.2;
+  o.high_order_optimize = false;
+  return mesh_needle(plain_rod_tip(2 * kRadius, kLength), half, o);
+}
+
+Eigen::MatrixX3d positions(const TetMesh& mesh) { return mesh.X; }
+
+// Depth of a point inside the exact cylinder (> 0 inside).
+double depth_in_rod(const Eigen::Vector3d& p) {
+  return std::min({kRadius - std::hypot(p.y(), p.z()), p.x() + kLength, -p.x()});
+}
+
+}  // namespace
+
+TEST_CASE("A segment across the rod meets its surface where the cylinder says", "[solver][bond_cut][gmsh]") {
+  for (bool half : {false, true}) {
+    const TetMesh mesh = rod_mesh(half);
+    const ContactSurface surface(mesh);
+    const NeedleBondCut cut(surface);
+    const Eigen::MatrixX3d x = positions(mesh);
+    // The faceted surface lies within the chord's sag of the cylinder: 0.2 mm edges on r 0.5.
+    const double sag = kRadius * (1 - std::cos(0.2 / kRadius / 2)) + 1e-6;
+    INFO((half ? "half" : "full") << " model");
+    for (double z : {0.0, 0.1, 0.3}) {
+      // Vertical segment from y = +0.8 to -0.8 at x = -2: enters and leaves at y = +-sqrt(r^2 - z^2).
+      const Eigen::Vector3d a(-2.0, 0.8, z), b(-2.0, -0.8, z);
+      const std::vector<double> s = cut.surface_crossings(a, b, x);
+      INFO("z = " << z);
+      REQUIRE(s.size() == 2);
+      const double y = std::sqrt(kRadius * kRadius - z * z);
+      CHECK(std::abs(s[0] - (0.8 - y) / 1.6) * 1.6 <= 2 * sag);
+      CHECK(std::abs(s[1] - (0.8 + y) / 1.6) * 1.6 <= 2 * sag);
+    }
+    // Beside the rod, inside it, and along it: no crossing, one, and the end face's.
+    CHECK(cut.surface_crossings({-2.0, 0.8, 0.0}, {-2.0, 0.6, 0.0}, x).empty());
+    CHECK(cut.surface_crossings({-2.0, 0.0, 0.0}, {-2.0, 0.8, 0.0}, x).size() == 1);
+    CHECK(cut.surface_crossings({-1.0, 0.0, 0.1}, {0.5, 0.0, 0.1}, x).size() == 1);
+  }
+}
+
+TEST_CASE("The bonds through the rod are those whose segment dips into the cylinder", "[solver][bond_cut][gmsh]") {
+  // A lattice through which the rod is pushed (its particles inside the rod removed, as a cut leaves
+  // them): a bond is cut where its segment passes through the cylinder, checked by sampling each segment
+  // against the closed form. Within the faceting's sag of the surface both answers are allowed.
+  const TetMesh mesh = rod_mesh(true);
+  const ContactSurface surface(mesh);
+  const NeedleBondCut cut(surface);
+  TissueBox box;
+  box.min_mm = {-3.0, -1.2, 0.0};
+  box.max_mm = {-1.0, 1.2, 1.2};
+  box.faces.fill(FaceCondition::free);
+  box.faces[4] = FaceCondition::symmetry;
+  LatticeOptions lattice;
+  lattice.spacing_mm = 0.2;
+  ParticleSet all = make_particle_lattice(box, lattice);
+  // Keep the particles outside the rod, shifted a little so that none sits on its surface.
+  std::vector<Eigen::Index> keep;
+  for (Eigen::Index i = 0; i < all.x_mm.rows(); ++i) {
+    all.x_mm(i, 0) += 0.013;
+    all.x_mm(i, 1) += 0.021;
+    if (depth_in_rod(all.x_mm.row(i).transpose()) < -0.05) keep.push_back(i);
+  }
+  ParticleSet outside;
+  outside.x_mm.resize(static_cast<Eigen::Index>(keep.size()), 3);
+  outside.volume_mm3.resize(static_cast<Eigen::Index>(keep.size()));
+  outside.spacing_mm.resize(static_cast<Eigen::Index>(keep.size()));
+  outside.flags.resize(static_cast<Eigen::Index>(keep.size()));
+  for (size_t k = 0; k < keep.size(); ++k) {
+    const Eigen::Index r = static_cast<Eigen::Index>(k);
+    outside.x_mm.row(r) = all.x_mm.row(keep[k]);
+    outside.volume_mm3[r] = all.volume_mm3[keep[k]];
+    outside.spacing_mm[r] = all.spacing_mm[keep[k]];
+    outside.flags[r] = all.flags[keep[k]];
+  }
+  SpgOptions spg;
+  spg.dilation = 4.0;  // supports of 0.8 mm: bonds long enough to cut across the rod's section near its surface
+  const SpgTissue tissue(outside, TissueMaterial{}, spg);
+  const std::vector<std::int64_t> through = cut.bonds_through_needle(tissue.bonds(), tissue.particles().position_mm, mesh.X);
+  REQUIRE(!through.empty());
+
+  const double sag = kRadius * (1 - std::cos(0.2 / kRadius / 2)) + 1e-6;
+  std::vector<std::uint8_t> is_cut(tissue.bonds().bonds.size(), 0);
+  for (std::int64_t b : through) is_cut[static_cast<size_t>(b)] = 1;
+  int expected = 0, mismatched = 0;
+  for (size_t b = 0; b < tissue.bonds().bonds.size(); ++b) {
+    const Bond& bond = tissue.bonds().bonds[b];
+    const Vec3d& p = tissue.particles().position_mm[static_cast<size_t>(bond.i)];
+    const Vec3d& q = tissue.particles().position_mm[static_cast<size_t>(bond.j)];
+    double deepest = -1e9;
+    for (int k = 0; k <= 400; ++k) {
+      Eigen::Vector3d sample = p + (q - p) * (k / 400.0);
+      sample.z() = std::abs(sample.z());  // the half model's mirror image closes the rod
+      deepest = std::max(deepest, depth_in_rod(sample));
+    }
+    if (deepest > sag) {
+      ++expected;
+      if (!is_cut[b]) ++mismatched;
+    } else if (deepest < -sag && is_cut[b]) {
+      ++mismatched;
+    }
+  }
+  INFO(through.size() << " bonds cut, " << expected << " clearly through the cylinder");
+  CHECK(expected > 20);
+  CHECK(mismatched == 0);
+}
