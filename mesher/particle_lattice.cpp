@@ -19,7 +19,9 @@ std::vector<double> axis_nodes(double a, double b, double h, std::optional<std::
     const double x0 = a + i * step;
     nodes.push_back(i == n ? b : x0);
     if (i == n || !roi) continue;
-    if (x0 + step <= (*roi)[0] || x0 >= (*roi)[1]) continue;  // this interval does not touch the region
+    // An interval that only touches the region at an end is not in it (up to rounding of the nodes).
+    const double tolerance = 1e-9 * step;
+    if (x0 + step <= (*roi)[0] + tolerance || x0 >= (*roi)[1] - tolerance) continue;
     for (int k = 1; k < refinement; ++k) nodes.push_back(x0 + step * k / refinement);
   }
   return nodes;
