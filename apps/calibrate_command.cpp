@@ -154,6 +154,8 @@ void add_calibrate_command(CLI::App& app) {
   c->add_option("--max-runs", o->max_runs, "Most runs to make (default 4)");
   c->add_option("--travel-mm", o->overrides.travel_mm, "Insertion travel (default 30)");
   c->add_option("--spacing-mm", o->overrides.spacing_mm, "Tissue particle spacing (default 0.4)");
+  c->add_option("--path-refinement", o->overrides.path_refinement,
+                 "Particles this many times finer within 1.2 mm of the needle's path (default: the scene's)");
   c->add_flag("--quiet", o->quiet, "No progress bars or result lines");
   c->add_option("--threads", o->threads, "Worker threads (default: the scene's; 0: all cores)");
   c->callback([o] { calibrate(*o); });

@@ -29,6 +29,12 @@ ParticleSet scene_particles(const Scene& scene) {
   if (!half) box.faces[4] = FaceCondition::fixed;
   LatticeOptions lattice;
   lattice.spacing_mm = t.spacing_mm;
+  if (t.path_refinement > 1) {
+    const double w = t.path_half_width_mm;
+    NEEDLE_REQUIRE(w < 0.5 * t.size_mm.y() && w < t.size_mm.z(),
+                   fmt::format("tissue: path_half_width_mm {} mm reaches the block's faces", w));
+    lattice.region_of_interest = RegionOfInterest{{box.min_mm.x(), -w, half ? 0.0 : -w}, {box.max_mm.x(), w, w}, t.path_refinement};
+  }
   return make_particle_lattice(box, lattice);
 }
 
@@ -72,7 +78,7 @@ class InsertionOutput {
                 "contact_force_x_N,contact_force_y_N,contact_force_z_N,particles_in_contact,particles_inside,max_depth_mm,"
                 "bonds_broken,tissue_kinetic_mJ,tissue_internal_mJ,needle_kinetic_mJ,needle_strain_mJ,drive_work_mJ,"
                 "cannula_work_mJ,contact_work_mJ,penalty_energy_mJ,friction_dissipation_mJ,relinearisation_energy_mJ,energy_balance_error,"
-                "coupling_step_ms,needle_steps,groove_fill,groove_floor_contact_fraction\n";
+                "coupling_step_ms,needle_steps,groove_fill,groove_floor_contact_fraction,bonds_cut_by_needle\n";
     facets_.open(folder.path("facet_forces.csv"));
     facets_ << "time_ms,insertion_mm";
     for (const std::string& tag : surface.tag_names())
@@ -89,12 +95,12 @@ class InsertionOutput {
     const InsertionEnergy& e = run.energy();
     history_ << fmt::format(
         "{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{},{},{:.6g},{},{:.9g},{:.9g},{:.9g},{:.9g},"
-        "{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.6g},{:.6g},{},{:.4f},{:.4f}\n",
+        "{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.6g},{:.6g},{},{:.4f},{:.4f},{}\n",
         run.time_ms(), drive.norm(), u.x(), u.y(), u.z(), u.y() - drive.y(), reaction.x(), reaction.y(), reaction.z(),
         c.force_on_needle_N.x(), c.force_on_needle_N.y(), c.force_on_needle_N.z(), c.particles_in_contact, c.particles_inside,
         c.max_depth_mm, run.bonds_broken(), e.tissue_kinetic_mJ, e.tissue_internal_mJ, e.needle_kinetic_mJ, e.needle_strain_mJ,
         e.drive_work_mJ, e.cannula_work_mJ, e.contact_work_mJ, e.penalty_energy_mJ, e.friction_dissipation_mJ, e.relinearisation_energy_mJ, e.balance_error(),
-        run.last_step_ms(), run.needle_steps(), groove.groove_fill, groove.floor_contact_fraction);
+        run.last_step_ms(), run.needle_steps(), groove.groove_fill, groove.floor_contact_fraction, run.bonds_cut_by_needle());
     facets_ << fmt::format("{:.9g},{:.9g}", run.time_ms(), drive.norm());
     for (size_t k = 0; k < surface_.tag_names().size(); ++k) {
       if (surface_.tag_names()[k] == "symmetry") continue;
@@ -157,6 +163,7 @@ Scene default_run_scene() {
   s.tissue.enabled = true;
   s.needle.mesh.size_mm = 0.4;
   s.solver.mass_scaling_dt_ms = 5e-6;
+  s.tissue.path_refinement = 2;  // 0.2 mm particles within 1.2 mm of the path: the tip's bevels see tissue
   return s;
 }
 
@@ -189,8 +196,8 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
   log.line(fmt::format("contact surface: {} triangles, level set {} voxels of {} mm ({:.1f} MiB) built in {:.2f} s", surface.num_triangles(),
                        surface.level_set().active_voxels(), surface.level_set().voxel_mm(), surface.level_set().memory_bytes() / 1048576.0,
                        surface.level_set().build_seconds()));
-  log.line(fmt::format("tissue: {} particles at {} mm, {} bonds; set-up {:.2f} s", particles.num_particles(), scene.tissue.spacing_mm,
-                       tissue.bonds().bonds.size(), setup_s));
+  log.line(fmt::format("tissue: {} particles at {} mm ({} mm near the path), {} bonds; set-up {:.2f} s", particles.num_particles(),
+                       scene.tissue.spacing_mm, particles.spacing_mm.minCoeff(), tissue.bonds().bonds.size(), setup_s));
 
   NeedleDynamics needle_run(needle, driven_base_supports(needle.mesh(), scene.motion, scene.direction), scene.cannula.enabled ? std::optional<CannulaOptions>(scene.cannula) : std::nullopt,
                             scene_dynamics_options(scene));
@@ -259,6 +266,7 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
       {"max_particles_inside", run.max_particles_inside()},
       {"particles", particles.num_particles()},
       {"bonds_broken", run.bonds_broken()},
+      {"bonds_cut_by_needle", run.bonds_cut_by_needle()},
       {"groove",
        {{"groove_fill", groove.groove_fill},
         {"floor_contact_fraction", groove.floor_contact_fraction},
@@ -313,6 +321,11 @@ void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
     scene.motion.validate("--travel-mm");
   }
   if (given(o.spacing_mm, "--spacing-mm")) scene.tissue.spacing_mm = o.spacing_mm;
+  if (o.path_refinement != 0) {
+    NEEDLE_REQUIRE(o.path_refinement >= 1 && o.path_refinement <= 8,
+                   fmt::format("--path-refinement must be an integer from 1 to 8 (got {})", o.path_refinement));
+    scene.tissue.path_refinement = o.path_refinement;
+  }
   if (given(o.mesh_size_mm, "--mesh-size-mm")) scene.needle.mesh.size_mm = o.mesh_size_mm;
 }
 

@@ -31,6 +31,7 @@ bool run_insertion_unless_done(const Scene& scene, const RunOptions& options);
 // The scene flags `needle run`, `paper` and `calibrate` share; NaN keeps the scene's value.
 struct SceneOverrides {
   double travel_mm = std::nan(""), spacing_mm = std::nan(""), mesh_size_mm = std::nan("");
+  int path_refinement = 0;  // 0: the scene's
 };
 // InputError naming the flag for a value that is not a positive number.
 void apply_scene_overrides(Scene& scene, const SceneOverrides& overrides);

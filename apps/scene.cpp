@@ -91,6 +91,8 @@ void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc) {
   NEEDLE_REQUIRE((t.size_mm.array() > 0).all(), fmt::format("{} must be three positive lengths", o.where("size_mm")));
   t.entry_x_mm = o.quantity("entry_x", Dimension::length, t.entry_x_mm, any_finite());
   t.spacing_mm = o.quantity("spacing", Dimension::length, t.spacing_mm, positive());
+  t.path_refinement = o.integer("path_refinement", t.path_refinement, 1, 8);
+  t.path_half_width_mm = o.quantity("path_half_width", Dimension::length, t.path_half_width_mm, positive());
   t.dilation = o.number("dilation", t.dilation, within(1.0, 4.0));
   t.spg.dilation = t.dilation;
   t.friction = o.number("friction", t.friction, non_negative());
@@ -116,6 +118,7 @@ void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc) {
     t.spg.bond_failure.measure = name("failure_measure", failure_measure_name(t.spg.bond_failure.measure), failure_measure_from_name);
     t.spg.bond_failure.strain = g.number("failure_strain", t.spg.bond_failure.strain, positive());
     t.spg.bond_failure.stretch_ratio = g.number("failure_stretch_ratio", t.spg.bond_failure.stretch_ratio, non_negative());
+    t.spg.crack_face_min_volume_ratio = g.number("crack_face_min_volume_ratio", t.spg.crack_face_min_volume_ratio, within(0.0, 0.99));
     t.spg.cfl = g.number("cfl", t.spg.cfl, within(1e-3, 1.0));
     g.finish();
   }
@@ -126,6 +129,7 @@ void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc) {
     t.contact.voxel_mm = c.quantity("voxel", Dimension::length, t.contact.voxel_mm, within(1e-3, 0.2));
     t.contact.damping_ratio = c.number("damping_ratio", t.contact.damping_ratio, within(0.0, 1.0));
     t.contact.needle_stiffness_scale = c.number("needle_stiffness_scale", t.contact.needle_stiffness_scale, within(1e-6, 0.5));
+    t.contact.cuts_bonds = c.boolean("cuts_bonds", t.contact.cuts_bonds);
     c.finish();
   }
   o.finish();
@@ -195,6 +199,7 @@ json scene_to_json(const Scene& s) {
   const TissueScene& t = s.tissue;
   const json tissue = {
       {"enabled", t.enabled}, {"size_mm", vector_json(t.size_mm)}, {"entry_x_mm", t.entry_x_mm}, {"spacing_mm", t.spacing_mm},
+      {"path_refinement", t.path_refinement}, {"path_half_width_mm", t.path_half_width_mm},
       {"dilation", t.dilation}, {"friction", t.friction}, {"material", material_to_json(t.material)},
       {"spg", {{"kernel_update", kernel_update_name(t.spg.kernel_update)},
                {"kernel_update_interval_steps", t.spg.kernel_update_interval_steps},
@@ -205,9 +210,11 @@ json scene_to_json(const Scene& s) {
                {"failure_measure", failure_measure_name(t.spg.bond_failure.measure)},
                {"failure_strain", t.spg.bond_failure.strain},
                {"failure_stretch_ratio", t.spg.bond_failure.stretch_ratio},
+               {"crack_face_min_volume_ratio", t.spg.crack_face_min_volume_ratio},
                {"cfl", t.spg.cfl}}},
       {"contact", {{"stiffness_factor", t.contact.stiffness_factor}, {"skin_mm", t.contact.skin_mm}, {"voxel_mm", t.contact.voxel_mm},
-                   {"damping_ratio", t.contact.damping_ratio}, {"needle_stiffness_scale", t.contact.needle_stiffness_scale}}}};
+                   {"damping_ratio", t.contact.damping_ratio}, {"needle_stiffness_scale", t.contact.needle_stiffness_scale},
+                   {"cuts_bonds", t.contact.cuts_bonds}}}};
   const CannulaOptions& c = s.cannula;
   return {
       {"needle", needle},

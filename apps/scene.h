@@ -35,6 +35,12 @@ struct TissueScene {
   Eigen::Vector3d size_mm{40.0, 8.0, 2.0};  // x from entry_x, y centred on the axis, z from the symmetry plane
   double entry_x_mm = 0.0;                  // the block's entry face (tip point A starts at x = 0)
   double spacing_mm = 0.4, dilation = 1.8, friction = 0.18;
+  // Finer particles around the needle's path (y = z = 0), over the block's whole length: within
+  // |y| <= path_half_width_mm and |z| <= path_half_width_mm the spacing is spacing_mm / path_refinement
+  // (1: a uniform lattice). The tip's facets are a few tenths of a millimetre high; the paper's 0.4 mm
+  // particles put one particle row on LMB's bottom bevel.
+  int path_refinement = 1;
+  double path_half_width_mm = 1.2;
   TissueMaterial material;
   SpgOptions spg;                           // kernel, stabilization, bond failure, cfl (docs/solver.md)
   ContactOptions contact;                   // friction copied from `friction`

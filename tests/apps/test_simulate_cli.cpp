@@ -193,11 +193,40 @@ TEST_CASE("needle run: a rod pushed into a small tissue block writes the coupled
   for (const char* field : {"displacement_mm", "plastic_strain", "broken_bonds", "in_contact"}) CHECK(text.find(field) != std::string::npos);
 }
 
+TEST_CASE("needle run: path_refinement puts finer particles around the needle's path only", "[apps][lspg][gmsh]") {
+  // Block x 0..2, y -1.2..1.2, z 0..1.2 at 0.4 mm; within |y|, z <= 0.4 mm of the path the spacing halves.
+  // Along x the refined band covers the whole length: 2 / 0.2 = 10 intervals. Along y: 0.8 mm at 0.2 and
+  // 1.6 mm at 0.4 = 8. Along z: 0.4 at 0.2 and 0.8 at 0.4 = 4. Lattice nodes: 11 x 9 x 5.
+  const fs::path dir = fresh_folder("insertion_refined");
+  write(dir / "scene.json", R"({
+    "needle": {"plain_rod": true, "length_mm": 6, "mesh": {"order": 1, "size_mm": 0.5}},
+    "motion": {"accel_time_ms": 0.02, "travel_mm": 0.5},
+    "cannula": {"enabled": false},
+    "tissue": {"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4, "path_refinement": 2, "path_half_width_mm": 0.4},
+    "solver": {"mass_scaling_dt_ms": 1e-5},
+    "output": {"frames": 0, "history_interval_ms": 0.02}
+  })");
+  const auto r = run("run --scene " + (dir / "scene.json").string() + " --out " + (dir / "run").string() + " --quiet", true);
+  INFO(r.out);
+  REQUIRE(r.exit_code == 0);
+  std::ifstream in(dir / "run" / "summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(in);
+  CHECK(summary["status"] == "finished");
+  CHECK(summary["particles"].get<int>() == 11 * 9 * 5);
+  CHECK(summary.contains("bonds_cut_by_needle"));
+  // A band wider than the block is refused before anything is written.
+  write(dir / "wide.json", R"({"needle": {"plain_rod": true}, "tissue": {"size_mm": [2, 2.4, 1.2], "path_refinement": 2, "path_half_width_mm": 1.5}})");
+  const auto wide = run("run --scene " + (dir / "wide.json").string() + " --out " + (dir / "wide").string() + " --quiet", true);
+  CHECK(wide.exit_code == 2);
+  CHECK_FALSE(fs::exists(dir / "wide"));
+}
+
 TEST_CASE("needle run: no needle, two needles or a bad number exit 2 with one line and no folder", "[apps][lspg]") {
   const fs::path dir = fresh_folder("run_bad");
   for (const std::string& args : {"run --out " + (dir / "a").string(), "run --preset SB --d-a 0 --out " + (dir / "a").string(),
                                  "run --preset SB --travel-mm -3 --out " + (dir / "a").string(),
-                                 "run --preset XX --out " + (dir / "a").string()}) {
+                                 "run --preset XX --out " + (dir / "a").string(),
+                                 "run --preset SB --path-refinement 9 --out " + (dir / "a").string()}) {
     const auto r = run(args, true);
     INFO(args << " -> " << r.out);
     CHECK(r.exit_code == 2);
