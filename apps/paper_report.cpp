@@ -35,7 +35,8 @@ struct NeedleRun {
   std::string name, folder, status, reason;
   double deflection_mm = kNaN, insertion_mm = kNaN, runtime_s = kNaN, groove_fill = kNaN, floor_contact_fraction = kNaN,
          mean_gap_mm = kNaN, max_energy_error = kNaN, max_penetration_mm = kNaN;
-  long bonds_broken = 0, particles_inside = 0, steps = 0;
+  long bonds_broken = 0, bonds_cut_by_needle = 0, particles_inside = 0, steps = 0, particles = 0;
+  std::string tissue_resolution;  // from the run's scene.json: the particle spacing and the needle's cut
   CsvTable history, facets;
 };
 
@@ -58,12 +59,29 @@ NeedleRun read_run(const std::string& out_dir, const std::string& name) {
   r.max_energy_error = number_or_nan(s, "max_energy_balance_error");
   r.max_penetration_mm = number_or_nan(s, "max_penetration_mm");
   r.bonds_broken = s.value("bonds_broken", 0L);
+  r.bonds_cut_by_needle = s.value("bonds_cut_by_needle", 0L);
   r.particles_inside = s.value("particles_inside", 0L);
   r.steps = s.value("steps", 0L);
   if (s.contains("groove") && s["groove"].is_object()) {
     r.groove_fill = number_or_nan(s["groove"], "groove_fill");
     r.floor_contact_fraction = number_or_nan(s["groove"], "floor_contact_fraction");
     r.mean_gap_mm = number_or_nan(s["groove"], "mean_gap_mm");
+  }
+  r.particles = s.value("particles", 0L);
+  const fs::path scene_path = fs::path(r.folder) / "scene.json";
+  if (fs::exists(scene_path)) {
+    const json scene = read_json_file(scene_path.string(), "run scene");
+    if (scene.contains("tissue") && scene["tissue"].is_object()) {
+      const json& t = scene["tissue"];
+      const double h = t.value("spacing_mm", kNaN);
+      const int refinement = t.value("path_refinement", 1);
+      r.tissue_resolution = refinement > 1 ? fmt::format("{:g} mm particles, {:g} mm within {:g} mm of the path", h, h / refinement,
+                                                         t.value("path_half_width_mm", kNaN))
+                                           : fmt::format("{:g} mm particles", h);
+      const bool cuts = t.contains("contact") && t["contact"].value("cuts_bonds", false);
+      r.tissue_resolution += fmt::format(" ({} particles); the needle {} the bonds its body passes through", r.particles,
+                                         cuts ? "cuts" : "does not cut");
+    }
   }
   r.history = read_csv_table((fs::path(r.folder) / "history.csv").string());
   r.facets = read_csv_table((fs::path(r.folder) / "facet_forces.csv").string());
@@ -307,6 +325,7 @@ void write_paper_report(const PaperReportInput& in) {
               {"insertion_mm", r.insertion_mm},
               {"max_energy_balance_error", r.max_energy_error},
               {"bonds_broken", r.bonds_broken},
+              {"bonds_cut_by_needle", r.bonds_cut_by_needle},
               {"run_folder", fs::relative(r.folder, dir).string()}};
     if (!r.reason.empty()) n["reason"] = r.reason;
     if (const PaperReferenceNeedle* ref = find_reference(in.reference, r.name)) {
@@ -346,6 +365,7 @@ void write_paper_report(const PaperReportInput& in) {
   md += fmt::format("Tissue E = {:.4g} MPa ({}). Every other number is the paper's (shared/SPEC.md); "
                     "the reference values come from `{}`.\n\n",
                     in.tissue_E_MPa, in.tissue_E_source, fs::proximate(in.reference_path).string());
+  if (!runs.empty() && !runs.front().tissue_resolution.empty()) md += fmt::format("Tissue: {}.\n\n", runs.front().tissue_resolution);
   if (!in.calibration_path.empty()) {
     const json cal = read_json_file(in.calibration_path, "calibration");
     md += fmt::format("## Calibration of E on {} alone\n\n", cal.value("needle", std::string("SB")));
@@ -408,7 +428,7 @@ void write_paper_report(const PaperReportInput& in) {
   md += "The y force the tissue exerts on each part of the needle at the end of insertion (N, +: pushes it up). The tip's "
         "facets and the groove floor are the two levers of the bending moment (the paper's M_t and M_b); the shaft behind the "
         "groove is near the cannula and bends the needle little.\n\n";
-  md += "| needle | tip facets | groove floor and walls | shaft | bonds broken |\n|---|---|---|---|---|\n";
+  md += "| needle | tip facets | groove floor and walls | shaft | bonds broken (cut by the needle) |\n|---|---|---|---|---|\n";
   for (const NeedleRun& r : runs) {
     if (r.facets.rows.empty()) continue;
     double tip = 0, groove = 0, shaft = 0;
@@ -422,11 +442,11 @@ void write_paper_report(const PaperReportInput& in) {
       else if (tag == "shaft") shaft += last[k];
       else if (tag != "base") tip += last[k];
     }
-    md += fmt::format("| {} | {:+.3f} | {:+.3f} | {:+.3f} | {} |\n", r.name, tip, groove, shaft, r.bonds_broken);
+    md += fmt::format("| {} | {:+.3f} | {:+.3f} | {:+.3f} | {} ({}) |\n", r.name, tip, groove, shaft, r.bonds_broken, r.bonds_cut_by_needle);
   }
   md += "\nWhere the groove's downward load outweighs the tip facets' upward force, the needle bends down. The paper's tissue "
-        "is cut at the tip point A and only slightly compressed in the groove; where few bonds break (of about 140 000), the "
-        "tissue is pushed aside instead and presses into the groove of every needle whose groove it fills "
+        "is cut at the tip point A and only slightly compressed in the groove. Here the needle cuts the bonds its body passes "
+        "through (docs/insertion.md); the tissue above the cut still rebounds into the groove and presses on its floor "
         "(docs/paper.md discusses it).\n\n![facet forces](facet_forces.png)\n\n";
   if (tips) md += "## The tips\n\n![the four tips](tips.png)\n\n";
   md += "## Runs\n\n| needle | folder | coupling steps | max energy-balance error | max penetration (mm) | particles inside at end | "

@@ -26,9 +26,11 @@ void write_run(const fs::path& dir, const std::string& name, const FakeRun& r) {
   fs::create_directories(folder);
   const json summary = {{"status", "finished"}, {"reason", ""}, {"deflection_mm", r.deflection_mm}, {"insertion_mm", 30.0},
                         {"runtime_s", 600.0}, {"steps", 8000}, {"max_energy_balance_error", 0.001}, {"max_penetration_mm", 0.01},
-                        {"particles_inside", 0}, {"bonds_broken", 100},
+                        {"particles_inside", 0}, {"bonds_broken", 100}, {"bonds_cut_by_needle", 80}, {"particles", 48843},
                         {"groove", {{"groove_fill", r.groove_fill}, {"floor_contact_fraction", r.groove_fill / 2}, {"mean_gap_mm", 0.1}}}};
   std::ofstream(folder / "summary.json") << summary.dump(2);
+  const json scene = {{"tissue", {{"spacing_mm", 0.4}, {"path_refinement", 2}, {"path_half_width_mm", 1.2}, {"contact", {{"cuts_bonds", true}}}}}};
+  std::ofstream(folder / "scene.json") << scene.dump(2);
   std::ofstream history(folder / "history.csv");
   history << "time_ms,insertion_mm,deflection_mm\n";
   for (int k = 0; k <= 30; ++k) history << k * 0.13 << "," << k << "," << r.deflection_mm * k / 30.0 << "\n";
@@ -91,6 +93,11 @@ TEST_CASE("needle paper --report-only: runs matching the experiment meet every t
   const std::string md = read_text(dir / "report.md");
   CHECK(md.find("| SB | -0.43 | -1.100 | -1.14 | -1.15 | +0.040 | finished | 10.0 min |") != std::string::npos);
   CHECK(md.find("not met") == std::string::npos);
+  // The tissue's resolution and the bonds the needle cut come from the runs' scene and summary.
+  CHECK(md.find("Tissue: 0.4 mm particles, 0.2 mm within 1.2 mm of the path (48843 particles); the needle cuts the bonds its body "
+                "passes through.") != std::string::npos);
+  CHECK(md.find("| -0.150 | +0.000 | +0.000 | 100 (80) |") != std::string::npos);
+  CHECK(results["needles"]["SB"]["bonds_cut_by_needle"].get<long>() == 80);
   CHECK(md.find("## Calibration of E on SB alone") != std::string::npos);
   CHECK(md.find("| 0.1 | -2.000 | finished |") != std::string::npos);
   CHECK(md.find("Chosen: E = 0.05 MPa (within the tolerance)") != std::string::npos);
