@@ -267,6 +267,7 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
       {"particles", particles.num_particles()},
       {"bonds_broken", run.bonds_broken()},
       {"bonds_cut_by_needle", run.bonds_cut_by_needle()},
+      {"bond_cut_s", run.bond_cut_s()},
       {"groove",
        {{"groove_fill", groove.groove_fill},
         {"floor_contact_fraction", groove.floor_contact_fraction},

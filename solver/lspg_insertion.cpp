@@ -1,6 +1,7 @@
 #include "solver/lspg_insertion.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <fmt/format.h>
 
@@ -106,7 +107,11 @@ void LspgInsertion::step(double end_time_ms) {
     throw;
   }
   in_step_ = false;
-  if (cuts_bonds_) tissue_.cut_bonds(bond_cut_.bonds_through_needle(tissue_.bonds(), tissue_.particles().position_mm, needle_.positions_mm()));
+  if (cuts_bonds_) {
+    const auto start = std::chrono::steady_clock::now();
+    tissue_.cut_bonds(bond_cut_.bonds_through_needle(tissue_.bonds(), tissue_.particles().position_mm, needle_.positions_mm()));
+    bond_cut_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
   ++steps_;
   last_dt_ms_ = dt;
   update_energy();

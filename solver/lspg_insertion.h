@@ -77,6 +77,7 @@ class LspgInsertion {
   double max_depth_mm() const { return max_depth_; }
   long bonds_broken() const { return static_cast<long>(tissue_.bonds().broken_count); }
   long bonds_cut_by_needle() const { return static_cast<long>(tissue_.bonds().cut_count); }
+  double bond_cut_s() const { return bond_cut_s_; }  // wall time spent finding the bonds the needle cuts
   // Momenta (g mm/ms) and what the drive put in.
   Eigen::Vector3d tissue_momentum() const;
   Eigen::Vector3d needle_momentum() const { return needle_.momentum(); }
@@ -94,6 +95,7 @@ class LspgInsertion {
   NeedleTissueContact contact_;
   NeedleBondCut bond_cut_;
   bool cuts_bonds_ = true;
+  double bond_cut_s_ = 0;
   InsertionEnergy energy_;
   bool in_step_ = false;
   double step_start_ms_ = 0, step_dt_ms_ = 0, last_dt_ms_ = 0, max_energy_error_ = 0, max_depth_ = 0;
