@@ -68,7 +68,7 @@ void calibrate(const CalibrateOptions& o) {
                  fmt::format("--preset '{}' is not one of SB, LMB, AMB, HMB", o.preset));
   NEEDLE_REQUIRE(std::isfinite(o.target_mm) && o.target_mm != 0, "--target-deflection-mm must be a non-zero number (SB: -1.14)");
   NEEDLE_REQUIRE(std::isfinite(o.tolerance_mm) && o.tolerance_mm > 0, "--tolerance-mm must be positive");
-  NEEDLE_REQUIRE(o.max_runs >= 2 && o.max_runs <= 20, "--max-runs must lie in [2, 20]");
+  NEEDLE_REQUIRE(o.max_runs >= 1 && o.max_runs <= 20, "--max-runs must lie in [1, 20]");
   Scene scene = default_run_scene();
   scene.needle.preset = o.preset;
   apply_scene_overrides(scene, o.overrides);

@@ -209,6 +209,8 @@ ForceReport SpgTissue::compute_forces(double dt_ms) {
     }
   });
   if (options_.bond_failure.enabled) report.bonds_broken_now = break_bonds();
+  report.particles_detached_now += detached_on_rebuild_;  // by this evaluation's breaks and cut_bonds since the last
+  detached_on_rebuild_ = 0;
   return report;
 }
 
@@ -273,18 +275,35 @@ std::int64_t SpgTissue::separate(const std::vector<std::uint8_t>& breaking) {
   if (rows.empty()) return count;
   std::sort(rows.begin(), rows.end());
   rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
+  // A detached particle stays detached: its row is not rebuilt (that would revive it with a support
+  // that already collapsed once).
+  rows.erase(std::remove_if(rows.begin(), rows.end(), [&](std::int64_t i) { return !rk_.valid[static_cast<size_t>(i)]; }), rows.end());
+  if (rows.empty()) return count;
   const Eigen::Map<const Eigen::VectorXd> radius(p_.support_radius_mm.data(), p_.size());
   rebuild_rk_rows(rk_, rows, reference_, reference_, radius);
   // The next stress increment must see only motion, not the change of shape functions: restart F there.
+  // Every rebuilt row is on a crack face now: where its new support measures a collapsed volume it
+  // detaches at once (as compute_forces would at the next evaluation), before its F can set the step.
   for (std::int64_t i : rows) {
     const size_t s = static_cast<size_t>(i);
     if (rk_.valid[s]) {
-      p_.deformation_gradient[s] = gather_gradient(rk_, i, p_.position_mm);
-      min_stretch_[s] = smallest_stretch(p_.deformation_gradient[s]);
-    } else {
-      p_.stress_MPa[s].setZero();
-      p_.elastic_left_cauchy_green[s].setIdentity();
+      const Mat3d F = gather_gradient(rk_, i, p_.position_mm);
+      const double J = F.determinant();
+      if (F.allFinite() && J > kMinJacobian && J >= options_.crack_face_min_volume_ratio) {
+        p_.deformation_gradient[s] = F;
+        min_stretch_[s] = smallest_stretch(F);
+        continue;
+      }
+      rk_.valid[s] = 0;
+      for (std::int64_t e = rk_.offset[s]; e < rk_.offset[s + 1]; ++e) {
+        rk_.psi[static_cast<size_t>(e)] = 0;
+        rk_.grad[static_cast<size_t>(e)] = {0, 0, 0};
+      }
+      defect_[s].setZero();
+      ++detached_on_rebuild_;
     }
+    p_.stress_MPa[s].setZero();
+    p_.elastic_left_cauchy_green[s].setIdentity();
   }
   return count;
 }

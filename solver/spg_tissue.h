@@ -104,6 +104,7 @@ class SpgTissue {
   std::vector<Vec3d> defect_;      // g_i
   std::vector<Mat3d> piola_volume_;  // V_i P_i
   std::int64_t steps_ = 0;
+  std::int64_t detached_on_rebuild_ = 0;  // crack-face particles separate() detached (counted into ForceReport)
 };
 
 }  // namespace needle
