@@ -196,7 +196,7 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
   log.line(fmt::format("contact surface: {} triangles, level set {} voxels of {} mm ({:.1f} MiB) built in {:.2f} s", surface.num_triangles(),
                        surface.level_set().active_voxels(), surface.level_set().voxel_mm(), surface.level_set().memory_bytes() / 1048576.0,
                        surface.level_set().build_seconds()));
-  log.line(fmt::format("tissue: {} particles at {} mm ({} mm near the path), {} bonds; set-up {:.2f} s", particles.num_particles(),
+  log.line(fmt::format("tissue: {} particles at {:.3g} mm ({:.3g} mm near the path), {} bonds; set-up {:.2f} s", particles.num_particles(),
                        scene.tissue.spacing_mm, particles.spacing_mm.minCoeff(), tissue.bonds().bonds.size(), setup_s));
 
   NeedleDynamics needle_run(needle, driven_base_supports(needle.mesh(), scene.motion, scene.direction), scene.cannula.enabled ? std::optional<CannulaOptions>(scene.cannula) : std::nullopt,

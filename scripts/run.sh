@@ -25,7 +25,7 @@ done
 ./build/bench/bench_needle | tee out/bench_needle.txt
 ./build/bench/bench_insertion | tee out/bench_insertion.txt
 # The paper reproduced: SB, LMB, AMB and HMB on the paper's scene with the tissue E calibrated on SB
-# (data/paper/calibration_sb.json, made by `needle calibrate`; docs/paper.md), about 15 minutes a needle
+# (data/paper/calibration_sb.json, made by `needle calibrate`; docs/paper.md), about 25 minutes a needle
 # on 2 cores. A run the solver stops is reported as such in the report, not an error of the main job.
 ./build/apps/needle paper --calibration data/paper/calibration_sb.json --out out/paper
 echo "results in out/: <preset>.json (report), <preset>.stl, <preset>_half.glb, <preset>.png,"
