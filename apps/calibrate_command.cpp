@@ -152,10 +152,7 @@ void add_calibrate_command(CLI::App& app) {
   c->add_option("--start-E-MPa", o->start_E_MPa, "First E to run (default: the card's 0.665)");
   c->add_option("--tolerance-mm", o->tolerance_mm, "Stop when within this of the target (default 0.05)");
   c->add_option("--max-runs", o->max_runs, "Most runs to make (default 4)");
-  c->add_option("--travel-mm", o->overrides.travel_mm, "Insertion travel (default 30)");
-  c->add_option("--spacing-mm", o->overrides.spacing_mm, "Tissue particle spacing (default 0.4)");
-  c->add_option("--path-refinement", o->overrides.path_refinement,
-                 "Particles this many times finer within 1.2 mm of the needle's path (default: the scene's)");
+  add_scene_override_options(c, o->overrides);
   c->add_flag("--quiet", o->quiet, "No progress bars or result lines");
   c->add_option("--threads", o->threads, "Worker threads (default: the scene's; 0: all cores)");
   c->callback([o] { calibrate(*o); });

@@ -330,4 +330,11 @@ void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
   if (given(o.mesh_size_mm, "--mesh-size-mm")) scene.needle.mesh.size_mm = o.mesh_size_mm;
 }
 
+void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
+  c->add_option("--travel-mm", o.travel_mm, "Insertion travel (default 30)");
+  c->add_option("--spacing-mm", o.spacing_mm, "Tissue particle spacing (default 0.4)");
+  c->add_option("--path-refinement", o.path_refinement,
+                "Particles this many times finer within 1.2 mm of the needle's path (default: the scene's)");
+}
+
 }  // namespace needle

@@ -2,6 +2,7 @@
 // The coupled L-SPG insertion of a scene (tissue.enabled): needle, particles, contact, solve, and the
 // run folder (docs/scenes.md): scene.json, history.csv, facet_forces.csv, summary.json, needle.pvd and
 // tissue.pvd with frames/, run.log. Used by `needle simulate` and `needle run`.
+#include <CLI/CLI.hpp>
 #include <cmath>
 #include <string>
 
@@ -35,5 +36,8 @@ struct SceneOverrides {
 };
 // InputError naming the flag for a value that is not a positive number.
 void apply_scene_overrides(Scene& scene, const SceneOverrides& overrides);
+// The flags run, paper and calibrate share: --travel-mm, --spacing-mm, --path-refinement (each command
+// adds --mesh-size-mm itself where it has it).
+void add_scene_override_options(CLI::App* command, SceneOverrides& overrides);
 
 }  // namespace needle

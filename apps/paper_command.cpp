@@ -121,10 +121,7 @@ void add_paper_command(CLI::App& app) {
   c->add_option("--tissue-E-MPa", o->tissue_E_MPa, "Tissue Young's modulus (default: the card's 0.665 MPa)");
   c->add_option("--calibration", o->calibration_file, "calibration.json from `needle calibrate` (its tissue_E_MPa)");
   c->add_option("--reference", o->reference, "The paper's reference table (default data/paper/reference.json)");
-  c->add_option("--travel-mm", o->overrides.travel_mm, "Insertion travel (default 30; shorter for a quick look)");
-  c->add_option("--spacing-mm", o->overrides.spacing_mm, "Tissue particle spacing (default 0.4)");
-  c->add_option("--path-refinement", o->overrides.path_refinement,
-                 "Particles this many times finer within 1.2 mm of the needle's path (default: the scene's)");
+  add_scene_override_options(c, o->overrides);
   c->add_option("--mesh-size-mm", o->overrides.mesh_size_mm, "Needle mesh size (run default 0.4)");
   c->add_flag("--report-only", o->report_only, "Only rewrite the report from the run folders already in OUT/runs");
   c->add_flag("--rerun", o->rerun, "Run every needle again even if OUT/runs holds a run of the same scene");

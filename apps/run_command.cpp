@@ -64,10 +64,7 @@ void add_run_command(CLI::App& app) {
   c->add_option("--recipe", o->recipe, "Grinding recipe (JSON)");
   c->add_option("--scene", o->scene_file, "Scene file (JSON) instead of the run defaults; tissue is switched on");
   c->add_option("--out", o->run.out_dir, "Run folder to create")->required();
-  c->add_option("--travel-mm", o->overrides.travel_mm, "Insertion travel (default 30)");
-  c->add_option("--spacing-mm", o->overrides.spacing_mm, "Tissue particle spacing (default 0.4)");
-  c->add_option("--path-refinement", o->overrides.path_refinement,
-                 "Particles this many times finer within 1.2 mm of the needle's path (default: the scene's)");
+  add_scene_override_options(c, o->overrides);
   c->add_option("--mesh-size-mm", o->overrides.mesh_size_mm, "Needle mesh size over the tip and groove (run default 0.4; paper 0.2)");
   c->add_option("--mass-scaling-dt-ms", o->mass_scaling_dt_ms, "Needle selective mass scaling target step (run default 5e-6; 0: off)");
   c->add_option("--tissue-E-MPa", o->tissue_E_MPa, "Tissue Young's modulus (the calibrated parameter; default 0.665)");

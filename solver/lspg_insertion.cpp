@@ -35,8 +35,7 @@ LspgInsertion::LspgInsertion(NeedleDynamics& needle, SpgTissue& tissue, const Co
       options_(coupling),
       tissue_dynamics_(tissue, {}, coupling.tissue_body_acceleration_mm_per_ms2),
       contact_(surface, tissue.particles(), tissue.material(), contact),
-      bond_cut_(surface),
-      cuts_bonds_(contact.cuts_bonds) {
+      bond_cut_(surface) {
   options_.validate();
   NEEDLE_REQUIRE(needle.steps() == 0 && needle.time_ms() == 0, "the coupled run must start with a needle at t = 0");
   NEEDLE_REQUIRE(surface.reference_positions().rows() == needle.positions_mm().rows(),
@@ -107,7 +106,7 @@ void LspgInsertion::step(double end_time_ms) {
     throw;
   }
   in_step_ = false;
-  if (cuts_bonds_) {
+  if (contact_.options().cuts_bonds) {
     const auto start = std::chrono::steady_clock::now();
     tissue_.cut_bonds(bond_cut_.bonds_through_needle(tissue_.bonds(), tissue_.particles().position_mm, needle_.positions_mm()));
     bond_cut_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -94,7 +94,6 @@ class LspgInsertion {
   TissueDynamics tissue_dynamics_;
   NeedleTissueContact contact_;
   NeedleBondCut bond_cut_;
-  bool cuts_bonds_ = true;
   double bond_cut_s_ = 0;
   InsertionEnergy energy_;
   bool in_step_ = false;

@@ -141,7 +141,7 @@ ForceReport SpgTissue::compute_forces(double dt_ms) {
       const Mat3d F = gather_gradient(rk_, i, p_.position_mm);
       const double J = F.determinant();
       const bool collapsed = !(J > kMinJacobian) || !F.allFinite();
-      if (collapsed || J < options_.crack_face_min_volume_ratio) {
+      if (!crack_face_support_holds(F, J)) {
         // A particle on a crack face (some bonds cut) whose remaining support collapses stops being an
         // integration point: it keeps its mass and moves on as a free particle. Intact material that
         // inverts is a blow-up; intact material merely compressed that far stays.
@@ -152,11 +152,7 @@ ForceReport SpgTissue::compute_forces(double dt_ms) {
           continue;
         }
         if (on_crack) {
-          status[s] = kDetached;
-          piola_volume_[s].setZero();
-          p_.stress_MPa[s].setZero();
-          p_.elastic_left_cauchy_green[s].setIdentity();
-          p_.effective_strain[s] = p_.plastic_strain[s];
+          status[s] = kDetached;  // detach() below, serially (it counts)
           continue;
         }
       }
@@ -182,13 +178,7 @@ ForceReport SpgTissue::compute_forces(double dt_ms) {
   report.rate_factor_capped = std::count(status.begin(), status.end(), std::uint8_t{kCapped});
   for (std::int64_t i = 0; i < n; ++i)
     if (status[static_cast<size_t>(i)] & kDetached) {
-      const size_t s = static_cast<size_t>(i);
-      rk_.valid[s] = 0;
-      for (std::int64_t e = rk_.offset[s]; e < rk_.offset[s + 1]; ++e) {
-        rk_.psi[static_cast<size_t>(e)] = 0;
-        rk_.grad[static_cast<size_t>(e)] = {0, 0, 0};
-      }
-      defect_[s].setZero();
+      detach(static_cast<size_t>(i));
       ++report.particles_detached_now;
     }
 
@@ -288,24 +278,33 @@ std::int64_t SpgTissue::separate(const std::vector<std::uint8_t>& breaking) {
     const size_t s = static_cast<size_t>(i);
     if (rk_.valid[s]) {
       const Mat3d F = gather_gradient(rk_, i, p_.position_mm);
-      const double J = F.determinant();
-      if (F.allFinite() && J > kMinJacobian && J >= options_.crack_face_min_volume_ratio) {
+      if (crack_face_support_holds(F, F.determinant())) {
         p_.deformation_gradient[s] = F;
         min_stretch_[s] = smallest_stretch(F);
         continue;
       }
-      rk_.valid[s] = 0;
-      for (std::int64_t e = rk_.offset[s]; e < rk_.offset[s + 1]; ++e) {
-        rk_.psi[static_cast<size_t>(e)] = 0;
-        rk_.grad[static_cast<size_t>(e)] = {0, 0, 0};
-      }
-      defect_[s].setZero();
       ++detached_on_rebuild_;
     }
-    p_.stress_MPa[s].setZero();
-    p_.elastic_left_cauchy_green[s].setIdentity();
+    detach(s);
   }
   return count;
+}
+
+bool SpgTissue::crack_face_support_holds(const Mat3d& F, double J) const {
+  return F.allFinite() && J > kMinJacobian && J >= options_.crack_face_min_volume_ratio;
+}
+
+void SpgTissue::detach(size_t s) {
+  rk_.valid[s] = 0;
+  for (std::int64_t e = rk_.offset[s]; e < rk_.offset[s + 1]; ++e) {
+    rk_.psi[static_cast<size_t>(e)] = 0;
+    rk_.grad[static_cast<size_t>(e)] = {0, 0, 0};
+  }
+  defect_[s].setZero();
+  piola_volume_[s].setZero();
+  p_.stress_MPa[s].setZero();
+  p_.elastic_left_cauchy_green[s].setIdentity();
+  p_.effective_strain[s] = p_.plastic_strain[s];
 }
 
 double SpgTissue::stable_time_step_ms() const {

@@ -89,6 +89,11 @@ class SpgTissue {
   // Marks the bonds flagged in breaking (1: cut, 2: dead, no live row changes) broken and rebuilds the rows
   // of their particles; the count of those newly broken.
   std::int64_t separate(const std::vector<std::uint8_t>& breaking);
+  // Whether a crack-face particle's support still measures a volume (SpgOptions::crack_face_min_volume_ratio).
+  bool crack_face_support_holds(const Mat3d& F, double J) const;
+  // Particle s stops being an integration point: its row, smoothing defect and stress are cleared; it
+  // moves on as a free mass point.
+  void detach(size_t s);
   void refresh_reference_matrix();
 
   TissueParticles p_;

@@ -25,6 +25,17 @@ fs::path fresh_folder(const std::string& name) {
 
 void write(const fs::path& path, const std::string& text) { std::ofstream(path) << text; }
 
+// A plain rod (6 mm, T4 0.5 mm, no cannula) pushed travel_mm into the tissue block `tissue` (JSON) by
+// `needle run --scene`; the run goes to dir/run. The exit code and output of the command.
+needle_test::Result run_rod_into_block(const fs::path& dir, const std::string& tissue, double travel_mm, int frames) {
+  write(dir / "scene.json", R"({"needle": {"plain_rod": true, "length_mm": 6, "mesh": {"order": 1, "size_mm": 0.5}},)"
+                                R"("motion": {"accel_time_ms": 0.02, "travel_mm": )" + std::to_string(travel_mm) + R"(},)"
+                                R"("cannula": {"enabled": false}, "tissue": )" + tissue + ","
+                                R"("solver": {"mass_scaling_dt_ms": 1e-5},)"
+                                R"("output": {"frames": )" + std::to_string(frames) + R"(, "history_interval_ms": 0.02}})");
+  return run("run --scene " + (dir / "scene.json").string() + " --out " + (dir / "run").string() + " --quiet", true);
+}
+
 std::string message_of(const std::string& text) {
   try {
     needle::parse_scene(text, "scene.json");
@@ -164,15 +175,7 @@ TEST_CASE("needle stiffness --json reports compliance and frequencies with the b
 
 TEST_CASE("needle run: a rod pushed into a small tissue block writes the coupled run folder", "[apps][lspg][gmsh]") {
   const fs::path dir = fresh_folder("insertion");
-  write(dir / "scene.json", R"({
-    "needle": {"plain_rod": true, "length_mm": 6, "mesh": {"order": 1, "size_mm": 0.5}},
-    "motion": {"accel_time_ms": 0.02, "travel_mm": 1.0},
-    "cannula": {"enabled": false},
-    "tissue": {"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4},
-    "solver": {"mass_scaling_dt_ms": 1e-5},
-    "output": {"frames": 2, "history_interval_ms": 0.02}
-  })");
-  const auto r = run("run --scene " + (dir / "scene.json").string() + " --out " + (dir / "run").string() + " --quiet", true);
+  const auto r = run_rod_into_block(dir, R"({"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4})", 1.0, 2);
   INFO(r.out);
   REQUIRE(r.exit_code == 0);
   for (const char* file : {"scene.json", "history.csv", "facet_forces.csv", "summary.json", "needle.pvd", "tissue.pvd", "run.log",
@@ -198,15 +201,8 @@ TEST_CASE("needle run: path_refinement puts finer particles around the needle's 
   // Along x the refined band covers the whole length: 2 / 0.2 = 10 intervals. Along y: 0.8 mm at 0.2 and
   // 1.6 mm at 0.4 = 8. Along z: 0.4 at 0.2 and 0.8 at 0.4 = 4. Lattice nodes: 11 x 9 x 5.
   const fs::path dir = fresh_folder("insertion_refined");
-  write(dir / "scene.json", R"({
-    "needle": {"plain_rod": true, "length_mm": 6, "mesh": {"order": 1, "size_mm": 0.5}},
-    "motion": {"accel_time_ms": 0.02, "travel_mm": 0.5},
-    "cannula": {"enabled": false},
-    "tissue": {"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4, "path_refinement": 2, "path_half_width_mm": 0.4},
-    "solver": {"mass_scaling_dt_ms": 1e-5},
-    "output": {"frames": 0, "history_interval_ms": 0.02}
-  })");
-  const auto r = run("run --scene " + (dir / "scene.json").string() + " --out " + (dir / "run").string() + " --quiet", true);
+  const auto r = run_rod_into_block(dir, R"({"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4, "path_refinement": 2, "path_half_width_mm": 0.4})",
+                                    0.5, 0);
   INFO(r.out);
   REQUIRE(r.exit_code == 0);
   std::ifstream in(dir / "run" / "summary.json");
