@@ -1,8 +1,10 @@
 // `needle calibrate`: finds the tissue's Young's modulus (the one parameter the paper does not give)
 // for which a needle's insertion ends at the measured deflection. Each evaluation is a full run of the
 // paper's scene (DIR/runs/E_<value>MPa, reused when already there with the same scene); the first step
-// assumes deflection proportional to E, the next ones are secant steps on the last two runs. Writes
-// DIR/calibration.json (E, every run, the sensitivity d delta / d E) and DIR/calibration.png.
+// assumes deflection proportional to E, the next ones are secant steps on the last two runs. Once the
+// target is met, one more run at E (1 + sensitivity step) measures the local slope d delta / d E, unless
+// a finished run already lies that close. Writes DIR/calibration.json (E, every run, the sensitivity)
+// and DIR/calibration.png.
 #include "apps/calibrate_command.h"
 
 #include <algorithm>
@@ -13,6 +15,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "apps/calibration_steps.h"
 #include "apps/insertion_run.h"
 #include "apps/json_file.h"
 #include "apps/scene.h"
@@ -29,6 +32,7 @@ namespace {
 struct CalibrateOptions {
   std::string preset = "SB", out_dir;
   double target_mm = std::nan(""), start_E_MPa = std::nan(""), tolerance_mm = 0.05;
+  double sensitivity_step = 0.2;  // relative change of E for the sensitivity run; 0: none
   SceneOverrides overrides;
   int max_runs = 4, threads = -1;
   bool quiet = false;
@@ -69,6 +73,8 @@ void calibrate(const CalibrateOptions& o) {
   NEEDLE_REQUIRE(std::isfinite(o.target_mm) && o.target_mm != 0, "--target-deflection-mm must be a non-zero number (SB: -1.14)");
   NEEDLE_REQUIRE(std::isfinite(o.tolerance_mm) && o.tolerance_mm > 0, "--tolerance-mm must be positive");
   NEEDLE_REQUIRE(o.max_runs >= 1 && o.max_runs <= 20, "--max-runs must lie in [1, 20]");
+  NEEDLE_REQUIRE(std::isfinite(o.sensitivity_step) && o.sensitivity_step >= 0 && o.sensitivity_step <= 1,
+                 "--sensitivity-step must lie in [0, 1] (a relative change of E; 0: no sensitivity run)");
   Scene scene = default_run_scene();
   scene.needle.preset = o.preset;
   apply_scene_overrides(scene, o.overrides);
@@ -80,34 +86,28 @@ void calibrate(const CalibrateOptions& o) {
   fs::create_directories(dir / "runs");
 
   std::vector<Evaluation> runs;
-  runs.push_back(evaluate(scene, start, dir / "runs", o));
+  auto points = [&] {
+    std::vector<CalibrationPoint> p;
+    for (const Evaluation& e : runs) p.push_back({e.E_MPa, e.deflection_mm, e.status == "finished"});
+    return p;
+  };
   auto converged = [&](const Evaluation& e) { return e.status == "finished" && std::abs(e.deflection_mm - o.target_mm) <= o.tolerance_mm; };
-  while (!converged(runs.back()) && static_cast<int>(runs.size()) < o.max_runs) {
-    const Evaluation& last = runs.back();
-    double next;
-    if (runs.size() == 1 || std::abs(last.deflection_mm - runs[runs.size() - 2].deflection_mm) < 1e-9) {
-      NEEDLE_REQUIRE(last.deflection_mm * o.target_mm > 0,
-                     fmt::format("at E = {:.4g} MPa the needle deflects {:+.3f} mm, the other way than the target {:+.3f} mm: "
-                                 "E alone cannot calibrate it",
-                                 last.E_MPa, last.deflection_mm, o.target_mm));
-      next = last.E_MPa * o.target_mm / last.deflection_mm;  // deflection proportional to E
-    } else {
-      const Evaluation& before = runs[runs.size() - 2];
-      const double slope = (last.deflection_mm - before.deflection_mm) / (last.E_MPa - before.E_MPa);
-      next = last.E_MPa + (o.target_mm - last.deflection_mm) / slope;
-    }
-    next = std::clamp(next, last.E_MPa / 10, last.E_MPa * 10);  // a step of at most a decade
-    runs.push_back(evaluate(scene, next, dir / "runs", o));
-  }
+  runs.push_back(evaluate(scene, start, dir / "runs", o));
+  while (!converged(runs.back()) && static_cast<int>(runs.size()) < o.max_runs)
+    runs.push_back(evaluate(scene, next_calibration_E_MPa(points(), o.target_mm), dir / "runs", o));
 
-  // The best run, and the sensitivity from the two runs closest to the target.
-  std::vector<Evaluation> sorted = runs;
-  std::sort(sorted.begin(), sorted.end(),
-            [&](const auto& a, const auto& b) { return std::abs(a.deflection_mm - o.target_mm) < std::abs(b.deflection_mm - o.target_mm); });
-  const Evaluation& best = sorted.front();
+  // The best run; its slope comes from the finished run nearest to it in E, made here when none lies
+  // within twice the sensitivity step.
+  std::size_t best_index = nearest_to_target(points(), o.target_mm);
+  if (o.sensitivity_step > 0 && converged(runs[best_index]) && needs_sensitivity_run(points(), best_index, o.sensitivity_step)) {
+    if (!o.quiet) fmt::print("sensitivity run at E (1 + {:g})\n", o.sensitivity_step);
+    runs.push_back(evaluate(scene, runs[best_index].E_MPa * (1 + o.sensitivity_step), dir / "runs", o));
+    best_index = nearest_to_target(points(), o.target_mm);
+  }
+  const Evaluation best = runs[best_index];
+  const std::optional<std::size_t> partner = nearest_in_E(points(), best_index);
   double slope = std::nan("");
-  if (sorted.size() >= 2 && std::abs(sorted[1].E_MPa - best.E_MPa) > 0)
-    slope = (sorted[1].deflection_mm - best.deflection_mm) / (sorted[1].E_MPa - best.E_MPa);
+  if (partner && best.status == "finished") slope = sensitivity_mm_per_MPa(points()[best_index], points()[*partner]);
   json list = json::array();
   for (const Evaluation& e : runs)
     list.push_back({{"E_MPa", e.E_MPa}, {"deflection_mm", e.deflection_mm}, {"status", e.status}, {"insertion_mm", e.insertion_mm},
@@ -120,6 +120,7 @@ void calibrate(const CalibrateOptions& o) {
                     {"deflection_mm", best.deflection_mm},
                     {"sensitivity_mm_per_MPa", std::isfinite(slope) ? json(slope) : json(nullptr)},
                     {"relative_sensitivity", std::isfinite(slope) ? json(slope * best.E_MPa / best.deflection_mm) : json(nullptr)},
+                    {"sensitivity_from_E_MPa", std::isfinite(slope) ? json::array({best.E_MPa, runs[*partner].E_MPa}) : json(nullptr)},
                     {"runs", list}};
   write_file_atomically((dir / "calibration.json").string(), [&](const std::string& scratch) { std::ofstream(scratch) << out.dump(2) << "\n"; });
   LinePlot plot;
@@ -151,7 +152,10 @@ void add_calibrate_command(CLI::App& app) {
   c->add_option("--out", o->out_dir, "Calibration folder (created; runs go to OUT/runs/E_<E>MPa)")->required();
   c->add_option("--start-E-MPa", o->start_E_MPa, "First E to run (default: the card's 0.665)");
   c->add_option("--tolerance-mm", o->tolerance_mm, "Stop when within this of the target (default 0.05)");
-  c->add_option("--max-runs", o->max_runs, "Most runs to make (default 4)");
+  c->add_option("--max-runs", o->max_runs, "Most runs to make toward the target (default 4)");
+  c->add_option("--sensitivity-step", o->sensitivity_step,
+                "Relative change of E for one extra run after convergence that measures d delta / d E, made unless a finished "
+                "run already lies within twice this (default 0.2; 0: none)");
   add_scene_override_options(c, o->overrides);
   c->add_flag("--quiet", o->quiet, "No progress bars or result lines");
   c->add_option("--threads", o->threads, "Worker threads (default: the scene's; 0: all cores)");
