@@ -376,11 +376,18 @@ void write_paper_report(const PaperReportInput& in) {
       md += fmt::format("| {:.4g} | {:+.3f} | {} |\n", r.value("E_MPa", kNaN), r.value("deflection_mm", kNaN), r.value("status", std::string()));
     const json sensitivity = cal.value("sensitivity_mm_per_MPa", json());
     const json relative = cal.value("relative_sensitivity", json());
-    md += fmt::format("\nChosen: E = {:.4g} MPa ({}). Sensitivity near it: d delta / d E = {} mm per MPa, i.e. {} % of delta per % of E "
-                      "(from the two runs nearest the target).\n\n",
-                      cal.value("tissue_E_MPa", kNaN), cal.value("converged", false) ? "within the tolerance" : "the nearest run; not within the command's tolerance",
-                      sensitivity.is_number() ? fmt::format("{:.3g}", sensitivity.get<double>()) : "n/a",
-                      relative.is_number() ? fmt::format("{:.2f}", relative.get<double>()) : "n/a");
+    const json pair = cal.value("sensitivity_from_E_MPa", json());
+    md += fmt::format("\nChosen: E = {:.4g} MPa ({}). ", cal.value("tissue_E_MPa", kNaN),
+                      cal.value("converged", false) ? "within the tolerance" : "the nearest run; not within the command's tolerance");
+    if (sensitivity.is_number() && relative.is_number())
+      md += fmt::format("Sensitivity near it: d delta / d E = {:.3g} mm per MPa, i.e. {:.2f} % of delta per % of E{}.\n\n",
+                        sensitivity.get<double>(), relative.get<double>(),
+                        pair.is_array() && pair.size() == 2
+                            ? fmt::format(" (from the runs at E = {:.4g} and {:.4g} MPa)", pair[0].get<double>(), pair[1].get<double>())
+                            : std::string(" (from the two runs nearest the target)"));
+    else
+      md += "Sensitivity: not measured (no second finished run near the chosen E; `needle calibrate` makes one unless "
+            "`--sensitivity-step 0`).\n\n";
   }
   md += "## Deflection at the end of insertion (mm, +y up: the groove side)\n\n";
   md += "| needle | d_a (mm) | this toolkit | experiment | LS-DYNA (paper) | ours - experiment | status | run time |\n";

@@ -67,7 +67,7 @@ TEST_CASE("needle paper --report-only: runs matching the experiment meet every t
   for (const auto& [name, r] : runs) write_run(dir, name, r);
   // E from a calibration file: the report shows its runs and uses its E.
   const json calibration = {{"needle", "SB"}, {"target_deflection_mm", -1.14}, {"tissue_E_MPa", 0.05}, {"converged", true},
-                            {"sensitivity_mm_per_MPa", -20.0}, {"relative_sensitivity", 0.9},
+                            {"sensitivity_mm_per_MPa", -18.0}, {"relative_sensitivity", 0.818}, {"sensitivity_from_E_MPa", {0.05, 0.1}},
                             {"runs", {{{"E_MPa", 0.1}, {"deflection_mm", -2.0}, {"status", "finished"}},
                                       {{"E_MPa", 0.05}, {"deflection_mm", -1.10}, {"status", "finished"}}}}};
   std::ofstream(dir / "calibration.json") << calibration.dump();
@@ -93,6 +93,7 @@ TEST_CASE("needle paper --report-only: runs matching the experiment meet every t
   const std::string md = read_text(dir / "report.md");
   CHECK(md.find("| SB | -0.43 | -1.100 | -1.14 | -1.15 | +0.040 | finished | 10.0 min |") != std::string::npos);
   CHECK(md.find("not met") == std::string::npos);
+  CHECK(md.find("d delta / d E = -18 mm per MPa, i.e. 0.82 % of delta per % of E (from the runs at E = 0.05 and 0.1 MPa)") != std::string::npos);
   // The tissue's resolution and the bonds the needle cut come from the runs' scene and summary.
   CHECK(md.find("Tissue: 0.4 mm particles, 0.2 mm within 1.2 mm of the path (48843 particles); the needle cuts the bonds its body "
                 "passes through.") != std::string::npos);
