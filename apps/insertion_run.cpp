@@ -328,6 +328,7 @@ void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
     scene.tissue.path_refinement = o.path_refinement;
   }
   if (given(o.mesh_size_mm, "--mesh-size-mm")) scene.needle.mesh.size_mm = o.mesh_size_mm;
+  if (o.no_needle_cut) scene.tissue.contact.cuts_bonds = false;
 }
 
 void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
@@ -335,6 +336,9 @@ void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
   c->add_option("--spacing-mm", o.spacing_mm, "Tissue particle spacing (default 0.4)");
   c->add_option("--path-refinement", o.path_refinement,
                 "Particles this many times finer within 1.2 mm of the needle's path (default: the scene's)");
+  c->add_flag("--no-needle-cut", o.no_needle_cut,
+              "The needle does not cut the bonds its body crosses; the tissue separates by bond failure alone, as in the paper's "
+              "model (scene key tissue.contact.cuts_bonds)");
 }
 
 }  // namespace needle

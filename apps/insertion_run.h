@@ -33,10 +33,11 @@ bool run_insertion_unless_done(const Scene& scene, const RunOptions& options);
 struct SceneOverrides {
   double travel_mm = std::nan(""), spacing_mm = std::nan(""), mesh_size_mm = std::nan("");
   int path_refinement = 0;  // 0: the scene's
+  bool no_needle_cut = false;  // tissue separates by bond failure alone (the paper's model)
 };
 // InputError naming the flag for a value that is not a positive number.
 void apply_scene_overrides(Scene& scene, const SceneOverrides& overrides);
-// The flags run, paper and calibrate share: --travel-mm, --spacing-mm, --path-refinement (each command
+// The flags run, paper and calibrate share: --travel-mm, --spacing-mm, --path-refinement, --no-needle-cut (each command
 // adds --mesh-size-mm itself where it has it).
 void add_scene_override_options(CLI::App* command, SceneOverrides& overrides);
 

@@ -27,13 +27,14 @@ void write(const fs::path& path, const std::string& text) { std::ofstream(path) 
 
 // A plain rod (6 mm, T4 0.5 mm, no cannula) pushed travel_mm into the tissue block `tissue` (JSON) by
 // `needle run --scene`; the run goes to dir/run. The exit code and output of the command.
-needle_test::Result run_rod_into_block(const fs::path& dir, const std::string& tissue, double travel_mm, int frames) {
+needle_test::Result run_rod_into_block(const fs::path& dir, const std::string& tissue, double travel_mm, int frames,
+                                       const std::string& flags = "") {
   write(dir / "scene.json", R"({"needle": {"plain_rod": true, "length_mm": 6, "mesh": {"order": 1, "size_mm": 0.5}},)"
                                 R"("motion": {"accel_time_ms": 0.02, "travel_mm": )" + std::to_string(travel_mm) + R"(},)"
                                 R"("cannula": {"enabled": false}, "tissue": )" + tissue + ","
                                 R"("solver": {"mass_scaling_dt_ms": 1e-5},)"
                                 R"("output": {"frames": )" + std::to_string(frames) + R"(, "history_interval_ms": 0.02}})");
-  return run("run --scene " + (dir / "scene.json").string() + " --out " + (dir / "run").string() + " --quiet", true);
+  return run("run --scene " + (dir / "scene.json").string() + " --out " + (dir / "run").string() + " --quiet " + flags, true);
 }
 
 std::string message_of(const std::string& text) {
@@ -229,4 +230,24 @@ TEST_CASE("needle run: no needle, two needles or a bad number exit 2 with one li
     CHECK(std::count(r.out.begin(), r.out.end(), '\n') == 1);
     CHECK_FALSE(fs::exists(dir / "a"));
   }
+}
+
+TEST_CASE("needle run --no-needle-cut: the tissue separates by bond failure alone", "[apps][lspg][gmsh]") {
+  // The same short insertion with and without the needle's cut: the flag turns the cut off and says
+  // so in the effective scene; with the cut on, the rod's passage cuts bonds.
+  auto run_variant = [](const std::string& name, const std::string& flags) {
+    const fs::path dir = fresh_folder(name);
+    const auto r = run_rod_into_block(dir, R"({"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4})", 0.8, 0, flags);
+    INFO(r.out);
+    REQUIRE(r.exit_code == 0);
+    std::ifstream summary_file(dir / "run" / "summary.json"), scene_file(dir / "run" / "scene.json");
+    return std::pair{nlohmann::json::parse(summary_file), nlohmann::json::parse(scene_file)};
+  };
+  const auto [cut_summary, cut_scene] = run_variant("insertion_cut", "");
+  const auto [plain_summary, plain_scene] = run_variant("insertion_no_cut", "--no-needle-cut");
+  CHECK(cut_scene["tissue"]["contact"]["cuts_bonds"] == true);
+  CHECK(plain_scene["tissue"]["contact"]["cuts_bonds"] == false);
+  CHECK(cut_summary["bonds_cut_by_needle"].get<long>() > 0);
+  CHECK(plain_summary["bonds_cut_by_needle"].get<long>() == 0);
+  CHECK(plain_summary["status"] == "finished");
 }
