@@ -37,6 +37,7 @@ struct NeedleRun {
          mean_gap_mm = kNaN, max_energy_error = kNaN, max_penetration_mm = kNaN;
   long bonds_broken = 0, bonds_cut_by_needle = 0, particles_inside = 0, steps = 0, particles = 0;
   std::string tissue_resolution;  // from the run's scene.json: the particle spacing and the needle's cut
+  bool needle_cuts = false;       // the scene's tissue.contact.cuts_bonds
   CsvTable history, facets;
 };
 
@@ -78,9 +79,9 @@ NeedleRun read_run(const std::string& out_dir, const std::string& name) {
       r.tissue_resolution = refinement > 1 ? fmt::format("{:g} mm particles, {:g} mm within {:g} mm of the path", h, h / refinement,
                                                          t.value("path_half_width_mm", kNaN))
                                            : fmt::format("{:g} mm particles", h);
-      const bool cuts = t.contains("contact") && t["contact"].value("cuts_bonds", false);
+      r.needle_cuts = t.contains("contact") && t["contact"].value("cuts_bonds", false);
       r.tissue_resolution += fmt::format(" ({} particles); the needle {} the bonds its body passes through", r.particles,
-                                         cuts ? "cuts" : "does not cut");
+                                         r.needle_cuts ? "cuts" : "does not cut");
     }
   }
   r.history = read_csv_table((fs::path(r.folder) / "history.csv").string());
@@ -433,8 +434,9 @@ void write_paper_report(const PaperReportInput& in) {
   md += "\n![groove fill](groove_fill.png)\n\n";
   md += "## Forces on the facets, and why a needle bends the way it does\n\n";
   md += "The y force the tissue exerts on each part of the needle at the end of insertion (N, +: pushes it up). The tip's "
-        "facets and the groove floor are the two levers of the bending moment (the paper's M_t and M_b); the shaft behind the "
-        "groove is near the cannula and bends the needle little.\n\n";
+        "facets and the groove floor are the paper's levers of the bending moment (M_t and M_b). The shaft is the rod's round "
+        "surface over the whole inserted length, the groove's underside included: where the tissue cut below the tip point stays "
+        "pressed down, it pushes the shaft up along all of it.\n\n";
   md += "| needle | tip facets | groove floor and walls | shaft | bonds broken (cut by the needle) |\n|---|---|---|---|---|\n";
   for (const NeedleRun& r : runs) {
     if (r.facets.rows.empty()) continue;
@@ -451,10 +453,15 @@ void write_paper_report(const PaperReportInput& in) {
     }
     md += fmt::format("| {} | {:+.3f} | {:+.3f} | {:+.3f} | {} ({}) |\n", r.name, tip, groove, shaft, r.bonds_broken, r.bonds_cut_by_needle);
   }
-  md += "\nWhere the groove's downward load outweighs the tip facets' upward force, the needle bends down. The paper's tissue "
-        "is cut at the tip point A and only slightly compressed in the groove. Here the needle cuts the bonds its body passes "
-        "through (docs/insertion.md); the tissue above the cut still rebounds into the groove and presses on its floor "
-        "(docs/paper.md discusses it).\n\n![facet forces](facet_forces.png)\n\n";
+  const bool all_cut = std::all_of(runs.begin(), runs.end(), [](const NeedleRun& r) { return r.needle_cuts; });
+  md += "\nThe needle bends the way the sum of the three columns points. The paper's tissue is cut at the tip point A and only "
+        "slightly compressed in the groove. ";
+  md += all_cut ? "Here the needle cuts the bonds its body passes through (docs/insertion.md); the tissue above the cut rebounds "
+                  "into the groove and presses on its floor, the tissue below stays pressed against the shaft, and the needle "
+                  "follows the channel its tip cut (docs/paper.md discusses it).\n\n"
+                : "Here the needle does not cut bonds in every run: the tissue separates by bond failure alone where it does not "
+                  "(docs/insertion.md, docs/paper.md).\n\n";
+  md += "![facet forces](facet_forces.png)\n\n";
   if (tips) md += "## The tips\n\n![the four tips](tips.png)\n\n";
   md += "## Runs\n\n| needle | folder | coupling steps | max energy-balance error | max penetration (mm) | particles inside at end | "
         "bonds broken | note |\n|---|---|---|---|---|---|---|---|\n";
