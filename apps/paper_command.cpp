@@ -140,6 +140,7 @@ void add_paper_command(CLI::App& app) {
     if (c->count("--spacing-mm")) line += fmt::format(" --spacing-mm {}", o->overrides.spacing_mm);
     if (c->count("--mesh-size-mm")) line += fmt::format(" --mesh-size-mm {}", o->overrides.mesh_size_mm);
     if (c->count("--path-refinement")) line += fmt::format(" --path-refinement {}", o->overrides.path_refinement);
+    if (o->overrides.no_needle_cut) line += " --no-needle-cut";
     paper(*o);
   });
 }

@@ -389,6 +389,17 @@ void write_paper_report(const PaperReportInput& in) {
     else
       md += "Sensitivity: not measured (no second finished run near the chosen E; `needle calibrate` makes one unless "
             "`--sensitivity-step 0`).\n\n";
+    // The calibration holds for this report only if its needle, run here at the chosen E, ends where
+    // the calibration's run did: a different model (flags, spacing, cut) breaks that.
+    const std::string cal_needle = cal.value("needle", std::string("SB"));
+    const double cal_deflection = cal.value("deflection_mm", kNaN), cal_tolerance = cal.value("tolerance_mm", 0.05);
+    for (const NeedleRun& r : runs)
+      if (r.name == cal_needle && std::isfinite(cal_deflection) && std::isfinite(r.deflection_mm) &&
+          std::abs(r.deflection_mm - cal_deflection) > cal_tolerance)
+        md += fmt::format("**The calibration does not hold for these runs:** {} here ends at {:+.3f} mm, against {:+.3f} mm in the "
+                          "calibration's run at the same E. These runs use another model than the calibration's; recalibrate "
+                          "with the same flags before reading the others as predictions.\n\n",
+                          r.name, r.deflection_mm, cal_deflection);
   }
   md += "## Deflection at the end of insertion (mm, +y up: the groove side)\n\n";
   md += "| needle | d_a (mm) | this toolkit | experiment | LS-DYNA (paper) | ours - experiment | status | run time |\n";
@@ -459,8 +470,11 @@ void write_paper_report(const PaperReportInput& in) {
   md += all_cut ? "Here the needle cuts the bonds its body passes through (docs/insertion.md); the tissue above the cut rebounds "
                   "into the groove and presses on its floor, the tissue below stays pressed against the shaft, and the needle "
                   "follows the channel its tip cut (docs/paper.md discusses it).\n\n"
-                : "Here the needle does not cut bonds in every run: the tissue separates by bond failure alone where it does not "
-                  "(docs/insertion.md, docs/paper.md).\n\n";
+        : std::none_of(runs.begin(), runs.end(), [](const NeedleRun& r) { return r.needle_cuts; })
+            ? "Here the needle cuts no bonds: the tissue separates by bond failure alone, as in the paper's model "
+              "(`--no-needle-cut`; docs/paper.md compares it with the cut).\n\n"
+            : "Here the needle cuts bonds in some runs only; where it does not, the tissue separates by bond failure alone "
+              "(docs/insertion.md, docs/paper.md).\n\n";
   md += "![facet forces](facet_forces.png)\n\n";
   if (tips) md += "## The tips\n\n![the four tips](tips.png)\n\n";
   md += "## Runs\n\n| needle | folder | coupling steps | max energy-balance error | max penetration (mm) | particles inside at end | "

@@ -67,6 +67,7 @@ TEST_CASE("needle paper --report-only: runs matching the experiment meet every t
   for (const auto& [name, r] : runs) write_run(dir, name, r);
   // E from a calibration file: the report shows its runs and uses its E.
   const json calibration = {{"needle", "SB"}, {"target_deflection_mm", -1.14}, {"tissue_E_MPa", 0.05}, {"converged", true},
+                            {"deflection_mm", -1.10}, {"tolerance_mm", 0.05},
                             {"sensitivity_mm_per_MPa", -18.0}, {"relative_sensitivity", 0.818}, {"sensitivity_from_E_MPa", {0.05, 0.1}},
                             {"runs", {{{"E_MPa", 0.1}, {"deflection_mm", -2.0}, {"status", "finished"}},
                                       {{"E_MPa", 0.05}, {"deflection_mm", -1.10}, {"status", "finished"}}}}};
@@ -105,6 +106,16 @@ TEST_CASE("needle paper --report-only: runs matching the experiment meet every t
   for (const char* png : {"deflection_vs_insertion.png", "deflection_bars.png", "groove_fill.png", "facet_forces.png"})
     CHECK(fs::file_size(dir / png) > 1000);
   CHECK(!fs::exists(dir / "tips.png"));
+  CHECK(md.find("The calibration does not hold") == std::string::npos);  // SB here ends where the calibration's run did
+
+  // A calibration made with another model: its SB run ended elsewhere at the same E. The report says so.
+  json other = calibration;
+  other["deflection_mm"] = -1.30;
+  std::ofstream(dir / "other_calibration.json") << other.dump();
+  const auto again = run("paper --report-only --no-tips --quiet --calibration " + (dir / "other_calibration.json").string() + " --out " + dir.string(), true);
+  REQUIRE(again.exit_code == 0);
+  CHECK(read_text(dir / "report.md").find("**The calibration does not hold for these runs:** SB here ends at -1.100 mm, against -1.300 mm") !=
+        std::string::npos);
 }
 
 TEST_CASE("needle paper --report-only: a wrong sign, a large error and a wrong groove ranking are reported as not met", "[apps][paper]") {
