@@ -105,9 +105,10 @@ void calibrate(const CalibrateOptions& o) {
     best_index = nearest_to_target(points(), o.target_mm);
   }
   const Evaluation best = runs[best_index];
-  const std::optional<std::size_t> partner = nearest_in_E(points(), best_index);
+  const std::vector<CalibrationPoint> final_points = points();
+  const std::optional<std::size_t> partner = nearest_in_E(final_points, best_index);
   double slope = std::nan("");
-  if (partner && best.status == "finished") slope = sensitivity_mm_per_MPa(points()[best_index], points()[*partner]);
+  if (partner && best.status == "finished") slope = sensitivity_mm_per_MPa(final_points[best_index], final_points[*partner]);
   json list = json::array();
   for (const Evaluation& e : runs)
     list.push_back({{"E_MPa", e.E_MPa}, {"deflection_mm", e.deflection_mm}, {"status", e.status}, {"insertion_mm", e.insertion_mm},

@@ -341,4 +341,14 @@ void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
               "model (scene key tissue.contact.cuts_bonds)");
 }
 
+std::string scene_override_arguments(const SceneOverrides& o) {
+  std::string line;
+  if (!std::isnan(o.travel_mm)) line += fmt::format(" --travel-mm {}", o.travel_mm);
+  if (!std::isnan(o.spacing_mm)) line += fmt::format(" --spacing-mm {}", o.spacing_mm);
+  if (!std::isnan(o.mesh_size_mm)) line += fmt::format(" --mesh-size-mm {}", o.mesh_size_mm);
+  if (o.path_refinement != 0) line += fmt::format(" --path-refinement {}", o.path_refinement);
+  if (o.no_needle_cut) line += " --no-needle-cut";
+  return line;
+}
+
 }  // namespace needle

@@ -40,5 +40,8 @@ void apply_scene_overrides(Scene& scene, const SceneOverrides& overrides);
 // The flags run, paper and calibrate share: --travel-mm, --spacing-mm, --path-refinement, --no-needle-cut (each command
 // adds --mesh-size-mm itself where it has it).
 void add_scene_override_options(CLI::App* command, SceneOverrides& overrides);
+// The flags that give these overrides again (each given value, with a leading space), for a command
+// line that regenerates a result.
+std::string scene_override_arguments(const SceneOverrides& overrides);
 
 }  // namespace needle

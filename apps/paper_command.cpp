@@ -136,11 +136,7 @@ void add_paper_command(CLI::App& app) {
     if (c->count("--tissue-E-MPa")) line += fmt::format(" --tissue-E-MPa {}", o->tissue_E_MPa);
     if (c->count("--calibration")) line += " --calibration " + o->calibration_file;
     if (c->count("--reference")) line += " --reference " + o->reference;
-    if (c->count("--travel-mm")) line += fmt::format(" --travel-mm {}", o->overrides.travel_mm);
-    if (c->count("--spacing-mm")) line += fmt::format(" --spacing-mm {}", o->overrides.spacing_mm);
-    if (c->count("--mesh-size-mm")) line += fmt::format(" --mesh-size-mm {}", o->overrides.mesh_size_mm);
-    if (c->count("--path-refinement")) line += fmt::format(" --path-refinement {}", o->overrides.path_refinement);
-    if (o->overrides.no_needle_cut) line += " --no-needle-cut";
+    line += scene_override_arguments(o->overrides);
     paper(*o);
   });
 }

@@ -464,13 +464,13 @@ void write_paper_report(const PaperReportInput& in) {
     }
     md += fmt::format("| {} | {:+.3f} | {:+.3f} | {:+.3f} | {} ({}) |\n", r.name, tip, groove, shaft, r.bonds_broken, r.bonds_cut_by_needle);
   }
-  const bool all_cut = std::all_of(runs.begin(), runs.end(), [](const NeedleRun& r) { return r.needle_cuts; });
+  const auto runs_cutting = std::count_if(runs.begin(), runs.end(), [](const NeedleRun& r) { return r.needle_cuts; });
   md += "\nThe needle bends the way the sum of the three columns points. The paper's tissue is cut at the tip point A and only "
         "slightly compressed in the groove. ";
-  md += all_cut ? "Here the needle cuts the bonds its body passes through (docs/insertion.md); the tissue above the cut rebounds "
+  md += runs_cutting == static_cast<long>(runs.size()) ? "Here the needle cuts the bonds its body passes through (docs/insertion.md); the tissue above the cut rebounds "
                   "into the groove and presses on its floor, the tissue below stays pressed against the shaft, and the needle "
                   "follows the channel its tip cut (docs/paper.md discusses it).\n\n"
-        : std::none_of(runs.begin(), runs.end(), [](const NeedleRun& r) { return r.needle_cuts; })
+        : runs_cutting == 0
             ? "Here the needle cuts no bonds: the tissue separates by bond failure alone, as in the paper's model "
               "(`--no-needle-cut`; docs/paper.md compares it with the cut).\n\n"
             : "Here the needle cuts bonds in some runs only; where it does not, the tissue separates by bond failure alone "
