@@ -38,7 +38,7 @@ struct CouplingOptions {
   double max_step_ms = 0.0;     // cap on the coupling step (0: the tissue's and the contact's limits only)
   double contact_courant = 0.1; // fraction of the contact's own stable step (2 sqrt(m/k)) a coupling step may
                                 // take: the accuracy knob of the subcycling (its error is first order in it)
-  double max_energy_error = 0.05;    // stop when the physical balance drifts beyond this (after the first work)
+  double max_energy_error = 0.05;    // stop when the physical balance drifts beyond this (once the work from outside exceeds the energy at t = 0)
   double max_depth_mm = 0.3;         // stop when a particle gets this deep inside the needle
   Eigen::Vector3d tissue_body_acceleration_mm_per_ms2 = Eigen::Vector3d::Zero();  // e.g. to press a block on
   void validate(const std::string& where = "coupling") const;
@@ -51,8 +51,10 @@ struct InsertionEnergy {
   double contact_work_mJ = 0;  // work of the contact forces on both bodies (should equal -(E_penalty + D_friction))
   double relinearisation_energy_mJ = 0;  // the contact's penalty jumps at geometry updates (diagnostic, not in the balance)
   double penalty_energy_mJ = 0, initial_penalty_energy_mJ = 0, friction_dissipation_mJ = 0;  // initial: overlaps at t = 0
-  // |inputs - stored - dissipated| / the largest term
+  // |inputs - stored - dissipated| / the largest term (the energy at t = 0 among them)
   double balance_error() const;
+  double initial_energy_mJ() const;  // kinetic, strain and penalty energy at t = 0
+  double external_work_mJ() const;   // the largest of the drive's, cannula's, supports' and body load's work
 };
 
 class LspgInsertion {
