@@ -29,6 +29,7 @@ namespace {
 struct PaperOptions {
   std::string out_dir, needles = "SB,LMB,AMB,HMB", reference = std::string(NEEDLE_DATA_DIR) + "/paper/reference.json";
   std::string calibration_file;
+  std::vector<std::string> compare;  // LABEL=FILE, other reports' results.json
   double tissue_E_MPa = std::nan("");
   SceneOverrides overrides;
   bool report_only = false, rerun = false, no_tips = false, quiet = false;
@@ -72,6 +73,12 @@ void paper(const PaperOptions& o) {
   }
   scene.tissue.material.validate();
   apply_scene_overrides(scene, o.overrides);
+  std::vector<ComparedModel> compare;
+  for (const std::string& c : o.compare) {
+    compare.push_back(parse_compared_model(c));
+    NEEDLE_REQUIRE(fs::is_regular_file(compare.back().results_path),
+                   fmt::format("--compare {}: no file '{}'", compare.back().label, compare.back().results_path));
+  }
 
   const fs::path dir(o.out_dir);
   const fs::path parent = fs::absolute(dir).parent_path();
@@ -106,6 +113,7 @@ void paper(const PaperOptions& o) {
   report.calibration_path = o.calibration_file;
   report.command_line = o.command_line;
   report.draw_tips = !o.no_tips;
+  report.compare = compare;
   write_paper_report(report);
   if (!o.quiet) fmt::print("wrote {}\n", (dir / "report.md").string());
 }
@@ -123,6 +131,9 @@ void add_paper_command(CLI::App& app) {
   c->add_option("--reference", o->reference, "The paper's reference table (default data/paper/reference.json)");
   add_scene_override_options(c, o->overrides);
   c->add_option("--mesh-size-mm", o->overrides.mesh_size_mm, "Needle mesh size (run default 0.4)");
+  c->add_option("--compare", o->compare,
+                "LABEL=FILE: set another report's results.json (another model: spacing, cut, E) beside this one in the report; "
+                "repeatable");
   c->add_flag("--report-only", o->report_only, "Only rewrite the report from the run folders already in OUT/runs");
   c->add_flag("--rerun", o->rerun, "Run every needle again even if OUT/runs holds a run of the same scene");
   c->add_flag("--no-tips", o->no_tips, "Skip the tip pictures (they need the CAD booleans, a few seconds each)");
@@ -137,6 +148,7 @@ void add_paper_command(CLI::App& app) {
     if (c->count("--calibration")) line += " --calibration " + o->calibration_file;
     if (c->count("--reference")) line += " --reference " + o->reference;
     line += scene_override_arguments(o->overrides);
+    for (const std::string& c : o->compare) line += fmt::format(" --compare \"{}\"", c);
     paper(*o);
   });
 }

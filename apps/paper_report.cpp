@@ -276,9 +276,133 @@ RgbImage tip_pictures(const std::vector<std::string>& names) {
   return image;
 }
 
+// Another model's report, read back from its results.json.
+struct ModelResults {
+  std::string label, path, tissue;
+  double tissue_E_MPa = kNaN;
+  std::vector<NeedleRun> needles;  // name, deflection_mm, groove_fill and status only
+};
+
+ModelResults read_model_results(const ComparedModel& model) {
+  const json j = read_json_file(model.results_path, "compared results");
+  NEEDLE_REQUIRE(j.contains("needles") && j["needles"].is_object(),
+                 fmt::format("{}: no 'needles' object (give the results.json of a `needle paper` report)", model.results_path));
+  ModelResults m;
+  m.label = model.label;
+  m.path = model.results_path;
+  m.tissue = j.value("tissue", std::string("n/a"));
+  m.tissue_E_MPa = number_or_nan(j, "tissue_E_MPa");
+  for (const auto& [name, v] : j["needles"].items()) {
+    NEEDLE_REQUIRE(v.is_object(), fmt::format("{}: needles.{} must be an object", model.results_path, name));
+    NeedleRun r;
+    r.name = name;
+    r.deflection_mm = number_or_nan(v, "deflection_mm");
+    r.groove_fill = number_or_nan(v, "groove_fill");
+    r.status = v.value("status", std::string("unknown"));
+    r.insertion_mm = number_or_nan(v, "insertion_mm");
+    m.needles.push_back(r);
+  }
+  return m;
+}
+
+const NeedleRun* find_run(const std::vector<NeedleRun>& runs, const std::string& name) {
+  for (const NeedleRun& r : runs)
+    if (r.name == name) return &r;
+  return nullptr;
+}
+
+RgbImage model_bars(const std::vector<ModelResults>& models, const std::vector<std::string>& needles,
+                    const std::vector<PaperReferenceNeedle>& reference) {
+  BarChart chart;
+  chart.title = "Deflection at the end: each model, the experiment, LS-DYNA";
+  chart.y_label = "deflection (mm)";
+  chart.categories = needles;
+  for (size_t k = 0; k < models.size(); ++k) {
+    BarSeries s{models[k].label, {}, k == 0 ? kOurs : plot_color(static_cast<int>(k) + 1)};
+    for (const std::string& n : needles) {
+      const NeedleRun* r = find_run(models[k].needles, n);
+      s.values.push_back(r ? r->deflection_mm : kNaN);
+    }
+    chart.series.push_back(s);
+  }
+  BarSeries experiment{"experiment", {}, kExperiment}, lsdyna{"LS-DYNA (paper)", {}, kLsDyna};
+  for (const std::string& n : needles) {
+    const PaperReferenceNeedle* ref = find_reference(reference, n);
+    experiment.values.push_back(ref ? ref->deflection_experiment_mm : kNaN);
+    lsdyna.values.push_back(ref ? ref->deflection_lsdyna_mm : kNaN);
+  }
+  chart.series.push_back(experiment);
+  chart.series.push_back(lsdyna);
+  return draw_bar_chart(chart);
+}
+
+// The section that sets this report beside other models: delta (and its ratio to SB's, which does not
+// depend on E to first order), the targets each model meets, and the groove fill.
+std::string models_section(const std::vector<ModelResults>& models, const std::vector<std::string>& needles,
+                           const std::vector<PaperReferenceNeedle>& reference) {
+  std::string md = "## The same needles under other models\n\n";
+  md += "Each row is a `needle paper` report (its results.json). In brackets: delta / delta_SB. That ratio does not depend "
+        "on E to first order, so it compares models whether or not each was calibrated.\n\n";
+  md += "| model | tissue | E (MPa) |";
+  std::string rule = "|---|---|---|";
+  for (const std::string& n : needles) md += fmt::format(" {} |", n), rule += "---|";
+  md += " targets met at its E |\n" + rule + "---|\n";
+  auto ratio = [](double d, double sb) { return std::isfinite(d) && std::isfinite(sb) && sb != 0 ? fmt::format(" ({:+.2f})", d / sb) : std::string(); };
+  for (const ModelResults& m : models) {
+    const NeedleRun* sb = find_run(m.needles, "SB");
+    md += fmt::format("| {} | {} | {} |", m.label, m.tissue, std::isfinite(m.tissue_E_MPa) ? fmt::format("{:.4g}", m.tissue_E_MPa) : "n/a");
+    for (const std::string& n : needles) {
+      const NeedleRun* r = find_run(m.needles, n);
+      md += r ? fmt::format(" {}{}{} |", fmt_mm(r->deflection_mm), n == "SB" ? "" : ratio(r->deflection_mm, sb ? sb->deflection_mm : kNaN),
+                            r->status == "finished" ? "" : " stopped")
+              : " |";
+    }
+    const std::vector<Target> targets = evaluate_targets(m.needles, reference);
+    const auto checked = std::count_if(targets.begin(), targets.end(), [](const Target& t) { return t.checked; });
+    const auto met = std::count_if(targets.begin(), targets.end(), [](const Target& t) { return t.checked && t.met; });
+    md += fmt::format(" {} of {} |\n", met, checked);
+  }
+  for (const bool experiment : {true, false}) {
+    const PaperReferenceNeedle* sb = find_reference(reference, "SB");
+    md += experiment ? "| experiment (paper) | | |" : "| LS-DYNA (paper) | 0.4 mm SPG particles, bond failure | |";
+    for (const std::string& n : needles) {
+      const PaperReferenceNeedle* ref = find_reference(reference, n);
+      if (!ref) {
+        md += " |";
+        continue;
+      }
+      const double d = experiment ? ref->deflection_experiment_mm : ref->deflection_lsdyna_mm;
+      const double d_sb = sb ? (experiment ? sb->deflection_experiment_mm : sb->deflection_lsdyna_mm) : kNaN;
+      md += fmt::format(" {:+.2f}{} |", d, n == "SB" ? "" : ratio(d, d_sb));
+    }
+    md += " |\n";
+  }
+  md += "\nGroove fill (the measure of this report, above):\n\n| model |";
+  rule = "|---|";
+  for (const std::string& n : needles) md += fmt::format(" {} |", n), rule += "---|";
+  md += "\n" + rule + "\n";
+  for (const ModelResults& m : models) {
+    md += fmt::format("| {} |", m.label);
+    for (const std::string& n : needles) {
+      const NeedleRun* r = find_run(m.needles, n);
+      md += r ? fmt::format(" {} |", fmt_mm(r->groove_fill, "{:.3f}")) : " |";
+    }
+    md += "\n";
+  }
+  md += "\n![models](models.png)\n\n";
+  return md;
+}
+
 bool is_paper_needle(const std::string& name) { return std::find(kPaperOrder.begin(), kPaperOrder.end(), name) != kPaperOrder.end(); }
 
 }  // namespace
+
+ComparedModel parse_compared_model(const std::string& text) {
+  const auto eq = text.find('=');
+  NEEDLE_REQUIRE(eq != std::string::npos && eq > 0 && eq + 1 < text.size(),
+                 fmt::format("--compare '{}': give LABEL=FILE, e.g. \"0.4 mm, cut=paper_04/results.json\"", text));
+  return {text.substr(0, eq), text.substr(eq + 1)};
+}
 
 std::vector<PaperReferenceNeedle> read_paper_reference(const std::string& path) {
   const json j = read_json_file(path, "paper's reference table");
@@ -313,6 +437,17 @@ void write_paper_report(const PaperReportInput& in) {
   for (const std::string& name : in.needles) runs.push_back(read_run(in.out_dir, name));
   const std::vector<Target> targets = evaluate_targets(runs, in.reference);
   const fs::path dir(in.out_dir);
+  const std::string tissue = runs.empty() ? std::string() : runs.front().tissue_resolution;
+  std::vector<ModelResults> models;
+  if (!in.compare.empty()) {
+    ModelResults self;
+    self.label = "this report";
+    self.tissue = tissue.empty() ? "n/a" : tissue;
+    self.tissue_E_MPa = in.tissue_E_MPa;
+    self.needles = runs;
+    models.push_back(self);
+    for (const ComparedModel& c : in.compare) models.push_back(read_model_results(c));
+  }
 
   // results.json
   json needles = json::object();
@@ -346,6 +481,7 @@ void write_paper_report(const PaperReportInput& in) {
                          "mean over the groove's length inside the tissue of the share of the groove's depth (floor to the rod's top) "
                          "that tissue fills, measured in the needle's own frame at the end of insertion (report.md, docs/paper.md)"},
                         {"targets", target_list},
+                        {"tissue", tissue},
                         {"reference", fs::proximate(in.reference_path).string()}};
 
   // The pictures.
@@ -358,6 +494,7 @@ void write_paper_report(const PaperReportInput& in) {
     if (is_paper_needle(n)) paper_tips.push_back(n);
   const bool tips = in.draw_tips && !paper_tips.empty();
   if (tips) save_png(tip_pictures(paper_tips), (dir / "tips.png").string());
+  if (!models.empty()) save_png(model_bars(models, in.needles, in.reference), (dir / "models.png").string());
 
   // report.md
   std::string md;
@@ -366,7 +503,7 @@ void write_paper_report(const PaperReportInput& in) {
   md += fmt::format("Tissue E = {:.4g} MPa ({}). Every other number is the paper's (shared/SPEC.md); "
                     "the reference values come from `{}`.\n\n",
                     in.tissue_E_MPa, in.tissue_E_source, fs::proximate(in.reference_path).string());
-  if (!runs.empty() && !runs.front().tissue_resolution.empty()) md += fmt::format("Tissue: {}.\n\n", runs.front().tissue_resolution);
+  if (!tissue.empty()) md += fmt::format("Tissue: {}.\n\n", tissue);
   if (!in.calibration_path.empty()) {
     const json cal = read_json_file(in.calibration_path, "calibration");
     md += fmt::format("## Calibration of E on {} alone\n\n", cal.value("needle", std::string("SB")));
@@ -417,7 +554,8 @@ void write_paper_report(const PaperReportInput& in) {
   md += "## The paper's targets\n\n| target | numbers | verdict |\n|---|---|---|\n";
   for (const Target& t : targets)
     md += fmt::format("| {} | {} | {} |\n", t.what, t.numbers, !t.checked ? "not checked (missing run)" : t.met ? "met" : "**not met**");
-  md += "\n## Groove filling\n\n";
+  if (!models.empty()) md += "\n" + models_section(models, in.needles, in.reference);
+  md += models.empty() ? "\n## Groove filling\n\n" : "## Groove filling\n\n";
   md += "`groove_fill`: at the end of insertion, in the needle's own frame (each particle pulled back through the needle "
         "surface nearest it), the groove inside the tissue is cut into 0.05 mm slices along x; in each, the tissue's lowest "
         "edge (particle centre less half a spacing) inside the groove's section gives the filled share of the groove's depth, "

@@ -8,7 +8,8 @@
 //   deflection_bars.png          delta of ours, the experiment and LS-DYNA per needle;
 //   groove_fill.png              groove fill per needle beside the measured sample lengths;
 //   facet_forces.png             the y force on each tip facet against insertion, one panel per needle;
-//   tips.png                     the four tips, from above and below.
+//   tips.png                     the four tips, from above and below;
+//   models.png                   with compared models: delta of each model, the experiment and LS-DYNA.
 // Every file is written whole or not at all.
 #include <string>
 #include <vector>
@@ -25,6 +26,15 @@ struct PaperReferenceNeedle {
 // InputError naming the file and key for a missing file, bad JSON or a missing number.
 std::vector<PaperReferenceNeedle> read_paper_reference(const std::string& path);
 
+// Another report's results.json, shown beside this one (`needle paper --compare LABEL=FILE`): the same
+// needles under another model (particle spacing, the needle's cut, E).
+struct ComparedModel {
+  std::string label, results_path;
+};
+
+// "LABEL=FILE" -> its parts; InputError for a missing label or file name.
+ComparedModel parse_compared_model(const std::string& text);
+
 struct PaperReportInput {
   std::string out_dir;                     // the report folder; run folders are out_dir/runs/NAME
   std::vector<std::string> needles;        // in the order to show
@@ -35,9 +45,10 @@ struct PaperReportInput {
   std::string calibration_path;            // calibration.json of `needle calibrate`, if E came from one
   std::string command_line;                // to regenerate
   bool draw_tips = true;
+  std::vector<ComparedModel> compare;      // other models' results.json, in the order to show
 };
 
-// InputError if a needle's run folder or its summary is missing.
+// InputError if a needle's run folder or its summary is missing, or a compared results.json cannot be read.
 void write_paper_report(const PaperReportInput& input);
 
 }  // namespace needle

@@ -152,3 +152,40 @@ TEST_CASE("needle paper refuses missing runs and unknown needles with one messag
   CHECK(r.exit_code == 2);
   CHECK(r.out.find("cannot read the paper's reference table") != std::string::npos);
 }
+
+TEST_CASE("needle paper --compare sets another model's results beside this one, with delta / delta_SB and the targets each meets",
+          "[apps][paper]") {
+  const fs::path other = fresh("compare_other"), dir = fresh("compare_this");
+  // Another model: SB up (wrong sign), LMB and AMB near the experiment, HMB 1.21 mm off: 2 of 6 targets.
+  const std::map<std::string, FakeRun> other_runs = {{"SB", {0.30, 0.2}}, {"LMB", {0.16, 0.9}}, {"AMB", {0.25, 0.5}}, {"HMB", {0.50, 0.3}}};
+  for (const auto& [name, r] : other_runs) write_run(other, name, r);
+  REQUIRE(run("paper --report-only --no-tips --quiet --tissue-E-MPa 0.2 --out " + other.string(), true).exit_code == 0);
+  const json other_results = read_json(other / "results.json");
+  CHECK(other_results["tissue"].get<std::string>().find("0.2 mm within 1.2 mm of the path") != std::string::npos);
+  const std::map<std::string, FakeRun> runs = {{"SB", {-1.10, 0.90}}, {"LMB", {0.12, 0.95}}, {"AMB", {0.20, 0.40}}, {"HMB", {1.20, 0.10}}};
+  for (const auto& [name, r] : runs) write_run(dir, name, r);
+
+  // A bad --compare is refused before anything is written.
+  auto bad = run("paper --report-only --no-tips --quiet --out " + dir.string() + " --compare " + (other / "results.json").string(), true);
+  CHECK(bad.exit_code == 2);
+  CHECK(bad.out.find("give LABEL=FILE") != std::string::npos);
+  bad = run("paper --report-only --no-tips --quiet --out " + dir.string() + " --compare other=/nonexistent/results.json", true);
+  CHECK(bad.exit_code == 2);
+  CHECK(bad.out.find("no file '/nonexistent/results.json'") != std::string::npos);
+  CHECK(!fs::exists(dir / "report.md"));
+
+  const auto result = run("paper --report-only --no-tips --quiet --tissue-E-MPa 0.05 --out " + dir.string() + " --compare \"coarse model=" +
+                              (other / "results.json").string() + "\"",
+                          true);
+  INFO(result.out);
+  REQUIRE(result.exit_code == 0);
+  const std::string md = read_text(dir / "report.md");
+  CHECK(md.find("## The same needles under other models") != std::string::npos);
+  // delta / delta_SB of each model: 0.16 / 0.30, 0.25 / 0.30, 0.50 / 0.30; ours 0.12 / -1.10 ...
+  CHECK(md.find("| 0.2 | +0.300 | +0.160 (+0.53) | +0.250 (+0.83) | +0.500 (+1.67) | 2 of 6 |") != std::string::npos);
+  CHECK(md.find("| 0.05 | -1.100 | +0.120 (-0.11) | +0.200 (-0.18) | +1.200 (-1.09) | 6 of 6 |") != std::string::npos);
+  CHECK(md.find("| experiment (paper) | | | -1.14 | +0.15 (-0.13) | +0.24 (-0.21) | +1.71 (-1.50) | |") != std::string::npos);
+  CHECK(md.find("| coarse model | 0.200 | 0.900 | 0.500 | 0.300 |") != std::string::npos);
+  CHECK(fs::file_size(dir / "models.png") > 1000);
+  CHECK(md.find("--compare \"coarse model=") != std::string::npos);  // the regenerate line keeps it
+}
