@@ -30,6 +30,7 @@ struct PaperOptions {
   std::string out_dir, needles = "SB,LMB,AMB,HMB", reference = std::string(NEEDLE_DATA_DIR) + "/paper/reference.json";
   std::string calibration_file;
   std::vector<std::string> compare;  // LABEL=FILE, other reports' results.json
+  std::string label = "this report";  // this report's row among the compared models
   double tissue_E_MPa = std::nan("");
   SceneOverrides overrides;
   bool report_only = false, rerun = false, no_tips = false, quiet = false;
@@ -114,6 +115,7 @@ void paper(const PaperOptions& o) {
   report.command_line = o.command_line;
   report.draw_tips = !o.no_tips;
   report.compare = compare;
+  report.label = o.label;
   write_paper_report(report);
   if (!o.quiet) fmt::print("wrote {}\n", (dir / "report.md").string());
 }
@@ -134,6 +136,7 @@ void add_paper_command(CLI::App& app) {
   c->add_option("--compare", o->compare,
                 "LABEL=FILE: set another report's results.json (another model: spacing, cut, E) beside this one in the report; "
                 "repeatable");
+  c->add_option("--label", o->label, "This report's name in the table of --compare (default 'this report')");
   c->add_flag("--report-only", o->report_only, "Only rewrite the report from the run folders already in OUT/runs");
   c->add_flag("--rerun", o->rerun, "Run every needle again even if OUT/runs holds a run of the same scene");
   c->add_flag("--no-tips", o->no_tips, "Skip the tip pictures (they need the CAD booleans, a few seconds each)");
@@ -148,6 +151,7 @@ void add_paper_command(CLI::App& app) {
     if (c->count("--calibration")) line += " --calibration " + o->calibration_file;
     if (c->count("--reference")) line += " --reference " + o->reference;
     line += scene_override_arguments(o->overrides);
+    if (c->count("--label")) line += fmt::format(" --label \"{}\"", o->label);
     for (const std::string& c : o->compare) line += fmt::format(" --compare \"{}\"", c);
     paper(*o);
   });

@@ -441,7 +441,7 @@ void write_paper_report(const PaperReportInput& in) {
   std::vector<ModelResults> models;
   if (!in.compare.empty()) {
     ModelResults self;
-    self.label = "this report";
+    self.label = in.label;
     self.tissue = tissue.empty() ? "n/a" : tissue;
     self.tissue_E_MPa = in.tissue_E_MPa;
     self.needles = runs;

@@ -46,6 +46,7 @@ struct PaperReportInput {
   std::string command_line;                // to regenerate
   bool draw_tips = true;
   std::vector<ComparedModel> compare;      // other models' results.json, in the order to show
+  std::string label = "this report";       // this report's model among them
 };
 
 // InputError if a needle's run folder or its summary is missing, or a compared results.json cannot be read.

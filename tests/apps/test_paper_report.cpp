@@ -174,7 +174,7 @@ TEST_CASE("needle paper --compare sets another model's results beside this one, 
   CHECK(bad.out.find("no file '/nonexistent/results.json'") != std::string::npos);
   CHECK(!fs::exists(dir / "report.md"));
 
-  const auto result = run("paper --report-only --no-tips --quiet --tissue-E-MPa 0.05 --out " + dir.string() + " --compare \"coarse model=" +
+  const auto result = run("paper --report-only --no-tips --quiet --tissue-E-MPa 0.05 --label \"fine model\" --out " + dir.string() + " --compare \"coarse model=" +
                               (other / "results.json").string() + "\"",
                           true);
   INFO(result.out);
@@ -184,6 +184,7 @@ TEST_CASE("needle paper --compare sets another model's results beside this one, 
   // delta / delta_SB of each model: 0.16 / 0.30, 0.25 / 0.30, 0.50 / 0.30; ours 0.12 / -1.10 ...
   CHECK(md.find("| 0.2 | +0.300 | +0.160 (+0.53) | +0.250 (+0.83) | +0.500 (+1.67) | 2 of 6 |") != std::string::npos);
   CHECK(md.find("| 0.05 | -1.100 | +0.120 (-0.11) | +0.200 (-0.18) | +1.200 (-1.09) | 6 of 6 |") != std::string::npos);
+  CHECK(md.find("| fine model | 0.900 | 0.950 | 0.400 | 0.100 |") != std::string::npos);
   CHECK(md.find("| experiment (paper) | | | -1.14 | +0.15 (-0.13) | +0.24 (-0.21) | +1.71 (-1.50) | |") != std::string::npos);
   CHECK(md.find("| coarse model | 0.200 | 0.900 | 0.500 | 0.300 |") != std::string::npos);
   CHECK(fs::file_size(dir / "models.png") > 1000);
