@@ -377,6 +377,28 @@ std::string models_section(const std::vector<ModelResults>& models, const std::v
     }
     md += " |\n";
   }
+  // Does the spread between the models cover the experiment? (A model choice then moves delta across
+  // it; where none does, no choice among these reaches the measurement.)
+  md += "\n";
+  for (const std::string& n : needles) {
+    const PaperReferenceNeedle* ref = find_reference(reference, n);
+    const PaperReferenceNeedle* ref_sb = find_reference(reference, "SB");
+    if (n == "SB" || !ref || !ref_sb || ref_sb->deflection_experiment_mm == 0) continue;
+    double lo = kNaN, hi = kNaN;
+    for (const ModelResults& m : models) {
+      const NeedleRun* r = find_run(m.needles, n);
+      const NeedleRun* sb = find_run(m.needles, "SB");
+      if (!r || !sb || !std::isfinite(r->deflection_mm / sb->deflection_mm) || sb->deflection_mm == 0) continue;
+      const double q = r->deflection_mm / sb->deflection_mm;
+      lo = std::isfinite(lo) ? std::min(lo, q) : q;
+      hi = std::isfinite(hi) ? std::max(hi, q) : q;
+    }
+    if (!std::isfinite(lo)) continue;
+    const double e = ref->deflection_experiment_mm / ref_sb->deflection_experiment_mm;
+    md += fmt::format("- {}: the models' delta / delta_SB span {:+.2f} to {:+.2f}; the experiment's {:+.2f} lies {}.\n", n, lo, hi, e,
+                      e >= lo && e <= hi ? "inside: the model choices move it across the measurement"
+                                         : "outside: none of these models reaches it");
+  }
   md += "\nGroove fill (the measure of this report, above):\n\n| model |";
   rule = "|---|";
   for (const std::string& n : needles) md += fmt::format(" {} |", n), rule += "---|";

@@ -156,8 +156,9 @@ TEST_CASE("needle paper refuses missing runs and unknown needles with one messag
 TEST_CASE("needle paper --compare sets another model's results beside this one, with delta / delta_SB and the targets each meets",
           "[apps][paper]") {
   const fs::path other = fresh("compare_other"), dir = fresh("compare_this");
-  // Another model: SB up (wrong sign), LMB and AMB near the experiment, HMB 1.21 mm off: 2 of 6 targets.
-  const std::map<std::string, FakeRun> other_runs = {{"SB", {0.30, 0.2}}, {"LMB", {0.16, 0.9}}, {"AMB", {0.25, 0.5}}, {"HMB", {0.50, 0.3}}};
+  // Another model: SB 0.84 mm off, LMB near the experiment, AMB too low (LMB > AMB + 0.1: the order
+  // fails), HMB 1.21 mm off, the groove ranking wrong: 1 of 6 targets.
+  const std::map<std::string, FakeRun> other_runs = {{"SB", {-0.30, 0.2}}, {"LMB", {0.16, 0.9}}, {"AMB", {0.02, 0.5}}, {"HMB", {0.50, 0.3}}};
   for (const auto& [name, r] : other_runs) write_run(other, name, r);
   REQUIRE(run("paper --report-only --no-tips --quiet --tissue-E-MPa 0.2 --out " + other.string(), true).exit_code == 0);
   const json other_results = read_json(other / "results.json");
@@ -181,10 +182,14 @@ TEST_CASE("needle paper --compare sets another model's results beside this one, 
   REQUIRE(result.exit_code == 0);
   const std::string md = read_text(dir / "report.md");
   CHECK(md.find("## The same needles under other models") != std::string::npos);
-  // delta / delta_SB of each model: 0.16 / 0.30, 0.25 / 0.30, 0.50 / 0.30; ours 0.12 / -1.10 ...
-  CHECK(md.find("| 0.2 | +0.300 | +0.160 (+0.53) | +0.250 (+0.83) | +0.500 (+1.67) | 2 of 6 |") != std::string::npos);
+  // delta / delta_SB of each model: 0.16 / -0.30, 0.02 / -0.30, 0.50 / -0.30; ours 0.12 / -1.10 ...
+  CHECK(md.find("| 0.2 | -0.300 | +0.160 (-0.53) | +0.020 (-0.07) | +0.500 (-1.67) | 1 of 6 |") != std::string::npos);
   CHECK(md.find("| 0.05 | -1.100 | +0.120 (-0.11) | +0.200 (-0.18) | +1.200 (-1.09) | 6 of 6 |") != std::string::npos);
   CHECK(md.find("| fine model | 0.900 | 0.950 | 0.400 | 0.100 |") != std::string::npos);
+  // The experiment's ratios (-0.13, -0.21, -1.50) against the span of the two models' ratios.
+  CHECK(md.find("- LMB: the models' delta / delta_SB span -0.53 to -0.11; the experiment's -0.13 lies inside") != std::string::npos);
+  CHECK(md.find("- AMB: the models' delta / delta_SB span -0.18 to -0.07; the experiment's -0.21 lies outside") != std::string::npos);
+  CHECK(md.find("- HMB: the models' delta / delta_SB span -1.67 to -1.09; the experiment's -1.50 lies inside") != std::string::npos);
   CHECK(md.find("| experiment (paper) | | | -1.14 | +0.15 (-0.13) | +0.24 (-0.21) | +1.71 (-1.50) | |") != std::string::npos);
   CHECK(md.find("| coarse model | 0.200 | 0.900 | 0.500 | 0.300 |") != std::string::npos);
   CHECK(fs::file_size(dir / "models.png") > 1000);
