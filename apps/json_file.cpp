@@ -1,5 +1,7 @@
 #include "apps/json_file.h"
 
+#include <limits>
+
 #include <fmt/format.h>
 #include <fstream>
 
@@ -15,6 +17,10 @@ nlohmann::json read_json_file(const std::string& path, const std::string& what) 
   } catch (const nlohmann::json::exception& e) {
     throw InputError(fmt::format("{}: not valid JSON ({})", path, e.what()));
   }
+}
+
+double number_or_nan(const nlohmann::json& j, const char* key) {
+  return j.contains(key) && j[key].is_number() ? j[key].get<double>() : std::numeric_limits<double>::quiet_NaN();
 }
 
 }  // namespace needle

@@ -8,4 +8,7 @@ namespace needle {
 
 nlohmann::json read_json_file(const std::string& path, const std::string& what);
 
+// j[key] when it is a number, NaN otherwise (a missing or null field).
+double number_or_nan(const nlohmann::json& j, const char* key);
+
 }  // namespace needle

@@ -5,8 +5,6 @@
 #include <filesystem>
 #include <fmt/format.h>
 #include <fstream>
-#include <limits>
-#include <map>
 #include <nlohmann/json.hpp>
 
 #include "apps/csv_table.h"
@@ -26,24 +24,15 @@ using json = nlohmann::json;
 
 namespace {
 
-const std::vector<std::string> kPaperOrder = {"SB", "LMB", "AMB", "HMB"};
-const Rgb kOurs{31, 119, 180}, kExperiment{60, 60, 60}, kLsDyna{255, 127, 14};
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
 // What one needle's run folder says.
-struct NeedleRun {
-  std::string name, folder, status, reason;
-  double deflection_mm = kNaN, insertion_mm = kNaN, runtime_s = kNaN, groove_fill = kNaN, floor_contact_fraction = kNaN,
-         mean_gap_mm = kNaN, max_energy_error = kNaN, max_penetration_mm = kNaN;
+struct NeedleRun : NeedleOutcome {
+  std::string folder, reason;
+  double runtime_s = kNaN, floor_contact_fraction = kNaN, mean_gap_mm = kNaN, max_energy_error = kNaN, max_penetration_mm = kNaN;
   long bonds_broken = 0, bonds_cut_by_needle = 0, particles_inside = 0, steps = 0, particles = 0;
   std::string tissue_resolution;  // from the run's scene.json: the particle spacing and the needle's cut
   bool needle_cuts = false;       // the scene's tissue.contact.cuts_bonds
   CsvTable history, facets;
 };
-
-double number_or_nan(const json& j, const char* key) {
-  return j.contains(key) && j[key].is_number() ? j[key].get<double>() : kNaN;
-}
 
 NeedleRun read_run(const std::string& out_dir, const std::string& name) {
   NeedleRun r;
@@ -89,12 +78,6 @@ NeedleRun read_run(const std::string& out_dir, const std::string& name) {
   return r;
 }
 
-const PaperReferenceNeedle* find_reference(const std::vector<PaperReferenceNeedle>& reference, const std::string& name) {
-  for (const PaperReferenceNeedle& r : reference)
-    if (r.name == name) return &r;
-  return nullptr;
-}
-
 void save_png(const RgbImage& image, const std::string& path) {
   write_file_atomically(path, [&](const std::string& scratch) { write_png(image, scratch); });
 }
@@ -105,61 +88,6 @@ void save_text(const std::string& text, const std::string& path) {
     out << text;
     NEEDLE_REQUIRE(out.good(), fmt::format("cannot write '{}'", path));
   });
-}
-
-std::string fmt_mm(double v, const char* f = "{:+.3f}") { return std::isfinite(v) ? fmt::format(fmt::runtime(f), v) : std::string("n/a"); }
-
-// The paper's targets (issue 7), each with its verdict and the numbers behind it.
-struct Target {
-  std::string what, numbers;
-  bool met = false, checked = false;
-};
-
-std::vector<Target> evaluate_targets(const std::vector<NeedleRun>& runs, const std::vector<PaperReferenceNeedle>& reference) {
-  std::map<std::string, const NeedleRun*> by;
-  for (const NeedleRun& r : runs) by[r.name] = &r;
-  auto delta = [&](const char* n) { return by.count(n) ? by[n]->deflection_mm : kNaN; };
-  auto fill = [&](const char* n) { return by.count(n) ? by[n]->groove_fill : kNaN; };
-  std::vector<Target> out;
-  const double sb = delta("SB"), lmb = delta("LMB"), amb = delta("AMB"), hmb = delta("HMB");
-  {
-    Target t{"sign and order: SB < 0 < LMB <~ AMB < HMB (<~: within 0.1 mm)",
-             fmt::format("SB {} / LMB {} / AMB {} / HMB {} mm", fmt_mm(sb), fmt_mm(lmb), fmt_mm(amb), fmt_mm(hmb))};
-    t.checked = std::isfinite(sb + lmb + amb + hmb);
-    t.met = t.checked && sb < 0 && lmb > 0 && lmb <= amb + 0.1 && amb < hmb;
-    out.push_back(t);
-  }
-  for (const char* n : {"SB", "LMB", "AMB"}) {
-    const PaperReferenceNeedle* ref = find_reference(reference, n);
-    Target t{fmt::format("{}: abs(delta - delta_experiment) <= 0.1 mm", n), "n/a"};
-    if (ref && std::isfinite(delta(n))) {
-      const double error = delta(n) - ref->deflection_experiment_mm;
-      t.numbers = fmt::format("{} - ({:+.2f}) = {:+.3f} mm", fmt_mm(delta(n)), ref->deflection_experiment_mm, error);
-      t.checked = true;
-      t.met = std::abs(error) <= 0.1;
-    }
-    out.push_back(t);
-  }
-  if (const PaperReferenceNeedle* ref = find_reference(reference, "HMB")) {
-    const double lsdyna_error = std::abs(ref->deflection_lsdyna_mm - ref->deflection_experiment_mm);
-    Target t{fmt::format("HMB: error below LS-DYNA's {:.2f} mm", lsdyna_error), "n/a"};
-    if (std::isfinite(hmb)) {
-      const double error = std::abs(hmb - ref->deflection_experiment_mm);
-      t.numbers = fmt::format("abs({} - ({:+.2f})) = {:.3f} mm", fmt_mm(hmb), ref->deflection_experiment_mm, error);
-      t.checked = true;
-      t.met = error < lsdyna_error;
-    }
-    out.push_back(t);
-  }
-  {
-    Target t{"groove fill ranks SB and LMB above AMB above HMB",
-             fmt::format("SB {} / LMB {} / AMB {} / HMB {}", fmt_mm(fill("SB"), "{:.3f}"), fmt_mm(fill("LMB"), "{:.3f}"),
-                         fmt_mm(fill("AMB"), "{:.3f}"), fmt_mm(fill("HMB"), "{:.3f}"))};
-    t.checked = std::isfinite(fill("SB") + fill("LMB") + fill("AMB") + fill("HMB"));
-    t.met = t.checked && std::min(fill("SB"), fill("LMB")) > fill("AMB") && fill("AMB") > fill("HMB");
-    out.push_back(t);
-  }
-  return out;
 }
 
 RgbImage deflection_plot(const std::vector<NeedleRun>& runs, const std::vector<PaperReferenceNeedle>& reference) {
@@ -276,188 +204,13 @@ RgbImage tip_pictures(const std::vector<std::string>& names) {
   return image;
 }
 
-// Another model's report, read back from its results.json.
-struct ModelResults {
-  std::string label, path, tissue;
-  double tissue_E_MPa = kNaN;
-  std::vector<NeedleRun> needles;  // name, deflection_mm, groove_fill and status only
-};
-
-ModelResults read_model_results(const ComparedModel& model) {
-  const json j = read_json_file(model.results_path, "compared results");
-  NEEDLE_REQUIRE(j.contains("needles") && j["needles"].is_object(),
-                 fmt::format("{}: no 'needles' object (give the results.json of a `needle paper` report)", model.results_path));
-  ModelResults m;
-  m.label = model.label;
-  m.path = model.results_path;
-  m.tissue = j.value("tissue", std::string("n/a"));
-  m.tissue_E_MPa = number_or_nan(j, "tissue_E_MPa");
-  for (const auto& [name, v] : j["needles"].items()) {
-    NEEDLE_REQUIRE(v.is_object(), fmt::format("{}: needles.{} must be an object", model.results_path, name));
-    NeedleRun r;
-    r.name = name;
-    r.deflection_mm = number_or_nan(v, "deflection_mm");
-    r.groove_fill = number_or_nan(v, "groove_fill");
-    r.status = v.value("status", std::string("unknown"));
-    r.insertion_mm = number_or_nan(v, "insertion_mm");
-    m.needles.push_back(r);
-  }
-  return m;
-}
-
-const NeedleRun* find_run(const std::vector<NeedleRun>& runs, const std::string& name) {
-  for (const NeedleRun& r : runs)
-    if (r.name == name) return &r;
-  return nullptr;
-}
-
-RgbImage model_bars(const std::vector<ModelResults>& models, const std::vector<std::string>& needles,
-                    const std::vector<PaperReferenceNeedle>& reference) {
-  BarChart chart;
-  chart.title = "Deflection at the end: each model, the experiment, LS-DYNA";
-  chart.y_label = "deflection (mm)";
-  chart.categories = needles;
-  for (size_t k = 0; k < models.size(); ++k) {
-    BarSeries s{models[k].label, {}, k == 0 ? kOurs : plot_color(static_cast<int>(k) + 1)};
-    for (const std::string& n : needles) {
-      const NeedleRun* r = find_run(models[k].needles, n);
-      s.values.push_back(r ? r->deflection_mm : kNaN);
-    }
-    chart.series.push_back(s);
-  }
-  BarSeries experiment{"experiment", {}, kExperiment}, lsdyna{"LS-DYNA (paper)", {}, kLsDyna};
-  for (const std::string& n : needles) {
-    const PaperReferenceNeedle* ref = find_reference(reference, n);
-    experiment.values.push_back(ref ? ref->deflection_experiment_mm : kNaN);
-    lsdyna.values.push_back(ref ? ref->deflection_lsdyna_mm : kNaN);
-  }
-  chart.series.push_back(experiment);
-  chart.series.push_back(lsdyna);
-  return draw_bar_chart(chart);
-}
-
-// The section that sets this report beside other models: delta (and its ratio to SB's, which does not
-// depend on E to first order), the targets each model meets, and the groove fill.
-std::string models_section(const std::vector<ModelResults>& models, const std::vector<std::string>& needles,
-                           const std::vector<PaperReferenceNeedle>& reference) {
-  std::string md = "## The same needles under other models\n\n";
-  md += "Each row is a `needle paper` report (its results.json). In brackets: delta / delta_SB. That ratio does not depend "
-        "on E to first order, so it compares models whether or not each was calibrated.\n\n";
-  md += "| model | tissue | E (MPa) |";
-  std::string rule = "|---|---|---|";
-  for (const std::string& n : needles) md += fmt::format(" {} |", n), rule += "---|";
-  md += " targets met at its E |\n" + rule + "---|\n";
-  auto ratio = [](double d, double sb) { return std::isfinite(d) && std::isfinite(sb) && sb != 0 ? fmt::format(" ({:+.2f})", d / sb) : std::string(); };
-  for (const ModelResults& m : models) {
-    const NeedleRun* sb = find_run(m.needles, "SB");
-    md += fmt::format("| {} | {} | {} |", m.label, m.tissue, std::isfinite(m.tissue_E_MPa) ? fmt::format("{:.4g}", m.tissue_E_MPa) : "n/a");
-    for (const std::string& n : needles) {
-      const NeedleRun* r = find_run(m.needles, n);
-      md += r ? fmt::format(" {}{}{} |", fmt_mm(r->deflection_mm), n == "SB" ? "" : ratio(r->deflection_mm, sb ? sb->deflection_mm : kNaN),
-                            r->status == "finished" ? "" : " stopped")
-              : " |";
-    }
-    const std::vector<Target> targets = evaluate_targets(m.needles, reference);
-    const auto checked = std::count_if(targets.begin(), targets.end(), [](const Target& t) { return t.checked; });
-    const auto met = std::count_if(targets.begin(), targets.end(), [](const Target& t) { return t.checked && t.met; });
-    md += fmt::format(" {} of {} |\n", met, checked);
-  }
-  for (const bool experiment : {true, false}) {
-    const PaperReferenceNeedle* sb = find_reference(reference, "SB");
-    md += experiment ? "| experiment (paper) | | |" : "| LS-DYNA (paper) | 0.4 mm SPG particles, bond failure | |";
-    for (const std::string& n : needles) {
-      const PaperReferenceNeedle* ref = find_reference(reference, n);
-      if (!ref) {
-        md += " |";
-        continue;
-      }
-      const double d = experiment ? ref->deflection_experiment_mm : ref->deflection_lsdyna_mm;
-      const double d_sb = sb ? (experiment ? sb->deflection_experiment_mm : sb->deflection_lsdyna_mm) : kNaN;
-      md += fmt::format(" {:+.2f}{} |", d, n == "SB" ? "" : ratio(d, d_sb));
-    }
-    md += " |\n";
-  }
-  // Does the spread between the models cover the experiment? (A model choice then moves delta across
-  // it; where none does, no choice among these reaches the measurement.)
-  md += "\n";
-  for (const std::string& n : needles) {
-    const PaperReferenceNeedle* ref = find_reference(reference, n);
-    const PaperReferenceNeedle* ref_sb = find_reference(reference, "SB");
-    if (n == "SB" || !ref || !ref_sb || ref_sb->deflection_experiment_mm == 0) continue;
-    double lo = kNaN, hi = kNaN;
-    for (const ModelResults& m : models) {
-      const NeedleRun* r = find_run(m.needles, n);
-      const NeedleRun* sb = find_run(m.needles, "SB");
-      if (!r || !sb || !std::isfinite(r->deflection_mm / sb->deflection_mm) || sb->deflection_mm == 0) continue;
-      const double q = r->deflection_mm / sb->deflection_mm;
-      lo = std::isfinite(lo) ? std::min(lo, q) : q;
-      hi = std::isfinite(hi) ? std::max(hi, q) : q;
-    }
-    if (!std::isfinite(lo)) continue;
-    const double e = ref->deflection_experiment_mm / ref_sb->deflection_experiment_mm;
-    md += fmt::format("- {}: the models' delta / delta_SB span {:+.2f} to {:+.2f}; the experiment's {:+.2f} lies {}.\n", n, lo, hi, e,
-                      e >= lo && e <= hi ? "inside: the model choices move it across the measurement"
-                                         : "outside: none of these models reaches it");
-  }
-  md += "\nGroove fill (the measure of this report, above):\n\n| model |";
-  rule = "|---|";
-  for (const std::string& n : needles) md += fmt::format(" {} |", n), rule += "---|";
-  md += "\n" + rule + "\n";
-  for (const ModelResults& m : models) {
-    md += fmt::format("| {} |", m.label);
-    for (const std::string& n : needles) {
-      const NeedleRun* r = find_run(m.needles, n);
-      md += r ? fmt::format(" {} |", fmt_mm(r->groove_fill, "{:.3f}")) : " |";
-    }
-    md += "\n";
-  }
-  md += "\n![models](models.png)\n\n";
-  return md;
-}
-
-bool is_paper_needle(const std::string& name) { return std::find(kPaperOrder.begin(), kPaperOrder.end(), name) != kPaperOrder.end(); }
-
 }  // namespace
-
-ComparedModel parse_compared_model(const std::string& text) {
-  const auto eq = text.find('=');
-  NEEDLE_REQUIRE(eq != std::string::npos && eq > 0 && eq + 1 < text.size(),
-                 fmt::format("--compare '{}': give LABEL=FILE, e.g. \"0.4 mm, cut=paper_04/results.json\"", text));
-  return {text.substr(0, eq), text.substr(eq + 1)};
-}
-
-std::vector<PaperReferenceNeedle> read_paper_reference(const std::string& path) {
-  const json j = read_json_file(path, "paper's reference table");
-  NEEDLE_REQUIRE(j.contains("needles") && j["needles"].is_object(), fmt::format("{}: no 'needles' object", path));
-  std::vector<PaperReferenceNeedle> out;
-  for (const auto& [name, v] : j["needles"].items()) {
-    PaperReferenceNeedle r;
-    r.name = name;
-    auto number = [&](const char* key) {
-      NEEDLE_REQUIRE(v.contains(key) && v[key].is_number(), fmt::format("{}: needles.{}.{} must be a number", path, name, key));
-      return v[key].get<double>();
-    };
-    r.d_a_mm = number("d_a_mm");
-    r.deflection_experiment_mm = number("deflection_experiment_mm");
-    r.deflection_lsdyna_mm = number("deflection_lsdyna_mm");
-    r.sample_length_mm = number("sample_length_mm");
-    r.groove_contact_in_model = v.value("groove_contact_in_model", std::string());
-    out.push_back(r);
-  }
-  auto rank = [](const std::string& n) {
-    const auto it = std::find(kPaperOrder.begin(), kPaperOrder.end(), n);
-    return static_cast<int>(it - kPaperOrder.begin());
-  };
-  std::stable_sort(out.begin(), out.end(), [&](const auto& a, const auto& b) {
-    return rank(a.name) != rank(b.name) ? rank(a.name) < rank(b.name) : a.name < b.name;
-  });
-  return out;
-}
 
 void write_paper_report(const PaperReportInput& in) {
   std::vector<NeedleRun> runs;
   for (const std::string& name : in.needles) runs.push_back(read_run(in.out_dir, name));
-  const std::vector<Target> targets = evaluate_targets(runs, in.reference);
+  const std::vector<NeedleOutcome> outcomes(runs.begin(), runs.end());
+  const std::vector<PaperTarget> targets = evaluate_paper_targets(outcomes, in.reference);
   const fs::path dir(in.out_dir);
   const std::string tissue = runs.empty() ? std::string() : runs.front().tissue_resolution;
   std::vector<ModelResults> models;
@@ -466,7 +219,7 @@ void write_paper_report(const PaperReportInput& in) {
     self.label = in.label;
     self.tissue = tissue.empty() ? "n/a" : tissue;
     self.tissue_E_MPa = in.tissue_E_MPa;
-    self.needles = runs;
+    self.needles = outcomes;
     models.push_back(self);
     for (const ComparedModel& c : in.compare) models.push_back(read_model_results(c));
   }
@@ -495,7 +248,7 @@ void write_paper_report(const PaperReportInput& in) {
     needles[r.name] = n;
   }
   json target_list = json::array();
-  for (const Target& t : targets) target_list.push_back({{"target", t.what}, {"numbers", t.numbers}, {"met", t.met}, {"checked", t.checked}});
+  for (const PaperTarget& t : targets) target_list.push_back({{"target", t.what}, {"numbers", t.numbers}, {"met", t.met}, {"checked", t.checked}});
   const json results = {{"needles", needles},
                         {"tissue_E_MPa", in.tissue_E_MPa},
                         {"tissue_E_source", in.tissue_E_source},
@@ -574,7 +327,7 @@ void write_paper_report(const PaperReportInput& in) {
   }
   md += "\n![deflection against insertion](deflection_vs_insertion.png)\n\n![deflection bars](deflection_bars.png)\n\n";
   md += "## The paper's targets\n\n| target | numbers | verdict |\n|---|---|---|\n";
-  for (const Target& t : targets)
+  for (const PaperTarget& t : targets)
     md += fmt::format("| {} | {} | {} |\n", t.what, t.numbers, !t.checked ? "not checked (missing run)" : t.met ? "met" : "**not met**");
   if (!models.empty()) md += "\n" + models_section(models, in.needles, in.reference);
   md += models.empty() ? "\n## Groove filling\n\n" : "## Groove filling\n\n";

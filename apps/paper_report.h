@@ -14,26 +14,10 @@
 #include <string>
 #include <vector>
 
+#include "apps/model_comparison.h"
+#include "apps/paper_results.h"
+
 namespace needle {
-
-struct PaperReferenceNeedle {
-  std::string name;
-  double d_a_mm = 0, deflection_experiment_mm = 0, deflection_lsdyna_mm = 0, sample_length_mm = 0;
-  std::string groove_contact_in_model;
-};
-
-// The needles of the reference file in the paper's order (SB, LMB, AMB, HMB, then any other by name).
-// InputError naming the file and key for a missing file, bad JSON or a missing number.
-std::vector<PaperReferenceNeedle> read_paper_reference(const std::string& path);
-
-// Another report's results.json, shown beside this one (`needle paper --compare LABEL=FILE`): the same
-// needles under another model (particle spacing, the needle's cut, E).
-struct ComparedModel {
-  std::string label, results_path;
-};
-
-// "LABEL=FILE" -> its parts; InputError for a missing label or file name.
-ComparedModel parse_compared_model(const std::string& text);
 
 struct PaperReportInput {
   std::string out_dir;                     // the report folder; run folders are out_dir/runs/NAME
