@@ -8,7 +8,6 @@
 #include "apps/json_file.h"
 #include "geometry/input_error.h"
 #include "plot/bar_chart.h"
-#include "plot/line_plot.h"
 
 namespace needle {
 using json = nlohmann::json;
@@ -59,7 +58,7 @@ RgbImage model_bars(const std::vector<ModelResults>& models, const std::vector<s
   chart.y_label = "deflection (mm)";
   chart.categories = needles;
   for (size_t k = 0; k < models.size(); ++k) {
-    BarSeries s{models[k].label, {}, k == 0 ? kOurs : plot_color(static_cast<int>(k) + 1)};
+    BarSeries s{models[k].label, {}, compared_model_colour(static_cast<int>(k))};
     for (const std::string& n : needles) {
       const NeedleOutcome* r = find_run(models[k].needles, n);
       s.values.push_back(r ? r->deflection_mm : kNaN);

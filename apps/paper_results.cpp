@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <fmt/format.h>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -99,6 +100,12 @@ std::vector<PaperTarget> evaluate_paper_targets(const std::vector<NeedleOutcome>
     out.push_back(t);
   }
   return out;
+}
+
+Rgb compared_model_colour(int k) {
+  if (k <= 0) return kOurs;
+  static const Rgb others[] = {{214, 39, 40}, {44, 160, 44}, {148, 103, 189}, {140, 86, 75}, {227, 119, 194}, {23, 190, 207}};
+  return others[static_cast<size_t>(k - 1) % std::size(others)];
 }
 
 }  // namespace needle

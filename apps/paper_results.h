@@ -49,4 +49,8 @@ std::string fmt_mm(double v, const char* format = "{:+.3f}");
 // The report's colours: this toolkit, the experiment, LS-DYNA.
 inline const Rgb kOurs{31, 119, 180}, kExperiment{60, 60, 60}, kLsDyna{255, 127, 14};
 
+// The colour of the k-th model set beside this report (k >= 1; k = 0 is this report, kOurs): never one
+// of the three above, so a compared model is not mistaken for the experiment or LS-DYNA.
+Rgb compared_model_colour(int k);
+
 }  // namespace needle

@@ -21,11 +21,21 @@ RgbImage draw_bar_chart(const BarChart& chart) {
   y_min = std::floor(y_min / step) * step, y_max = std::ceil(y_max / step) * step;
   if (y_max - y_min < 1.5 * step) y_max += step;  // room for the value labels
 
-  RgbImage image(chart.width_px, chart.height_px);
   TextWriter title(20), text(15), small(13);
   const Rgb ink{30, 30, 30}, grid{225, 225, 225};
   const int left = 90, right = 20, top = 50, bottom = 60;
-  const int w = chart.width_px - left - right, h = chart.height_px - top - bottom;
+  const int categories = static_cast<int>(chart.categories.size());
+  const int bars = static_cast<int>(chart.series.size());
+  // Every bar at least as wide as the widest value label (and a gap), so that the labels of
+  // neighbouring bars never overlap: many series widen the chart instead.
+  int widest_label = 0;
+  for (const BarSeries& s : chart.series)
+    for (double v : s.values)
+      if (std::isfinite(v)) widest_label = std::max(widest_label, small.width(fmt::format(fmt::runtime(chart.value_format), v)));
+  const int bars_width = static_cast<int>(std::ceil(std::max(1, categories) * std::max(1, bars) * (widest_label + 6) / 0.8));
+  const int width_px = std::max(chart.width_px, left + right + bars_width);
+  RgbImage image(width_px, chart.height_px);
+  const int w = width_px - left - right, h = chart.height_px - top - bottom;
   auto py = [&](double y) { return top + h - (y - y_min) / (y_max - y_min) * h; };
   title.draw(image, left, 32, chart.title, ink);
   for (double y = y_min; y <= y_max + 1e-9 * step; y += step) {
@@ -34,8 +44,6 @@ RgbImage draw_bar_chart(const BarChart& chart) {
     text.draw(image, left - 8 - text.width(label), static_cast<int>(py(y)) + 5, label, ink);
   }
   text.draw_vertical(image, 24, top + h / 2 + text.width(chart.y_label) / 2, chart.y_label, ink);
-  const int categories = static_cast<int>(chart.categories.size());
-  const int bars = static_cast<int>(chart.series.size());
   const double group = static_cast<double>(w) / std::max(1, categories);
   const double bar = 0.8 * group / std::max(1, bars);
   for (int c = 0; c < categories; ++c) {

@@ -19,7 +19,7 @@ struct BarChart {
   std::vector<std::string> categories;
   std::vector<BarSeries> series;
   std::string value_format = "{:+.2f}";
-  int width_px = 900, height_px = 600;
+  int width_px = 900, height_px = 600;  // the width grows where the value labels would not fit their bars
 };
 
 // InputError if no bar has a finite value.

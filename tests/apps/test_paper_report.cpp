@@ -2,12 +2,14 @@
 // targets' verdicts, results.json and the plots follow from those numbers; missing runs and bad
 // needle names are refused with one message and exit 2.
 #include <catch2/catch.hpp>
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 
+#include "apps/paper_results.h"
 #include "cli_run.h"
 
 namespace fs = std::filesystem;
@@ -194,4 +196,15 @@ TEST_CASE("needle paper --compare sets another model's results beside this one, 
   CHECK(md.find("| coarse model | 0.200 | 0.900 | 0.500 | 0.300 |") != std::string::npos);
   CHECK(fs::file_size(dir / "models.png") > 1000);
   CHECK(md.find("--compare \"coarse model=") != std::string::npos);  // the regenerate line keeps it
+}
+
+TEST_CASE("Compared models get colours of their own, never the experiment's or LS-DYNA's", "[cli][paper]") {
+  std::vector<needle::Rgb> used = {needle::kExperiment, needle::kLsDyna};
+  for (int k = 0; k < 6; ++k) {
+    const needle::Rgb c = needle::compared_model_colour(k);
+    INFO("model " << k);
+    CHECK(std::find(used.begin(), used.end(), c) == used.end());
+    used.push_back(c);
+  }
+  CHECK(needle::compared_model_colour(0) == needle::kOurs);
 }

@@ -1,0 +1,73 @@
+// Grouped bar charts (plot/bar_chart.h): a bar's area is proportional to its value, and the value
+// labels fit their bars however many series share a group.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <fmt/format.h>
+
+#include "plot/bar_chart.h"
+
+using namespace needle;
+
+namespace {
+
+long count_pixels(const RgbImage& image, const Rgb& c) {
+  long n = 0;
+  for (size_t p = 0; p + 2 < image.rgb.size(); p += 3)
+    if (image.rgb[p] == c[0] && image.rgb[p + 1] == c[1] && image.rgb[p + 2] == c[2]) ++n;
+  return n;
+}
+
+// The longest horizontal run of pixels of colour c in any row.
+int widest_run(const RgbImage& image, const Rgb& c) {
+  int best = 0;
+  for (int y = 0; y < image.height; ++y) {
+    int run = 0;
+    for (int x = 0; x < image.width; ++x) {
+      const size_t p = 3 * (static_cast<size_t>(y) * image.width + x);
+      const bool match = image.rgb[p] == c[0] && image.rgb[p + 1] == c[1] && image.rgb[p + 2] == c[2];
+      run = match ? run + 1 : 0;
+      best = std::max(best, run);
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+TEST_CASE("A bar's area is proportional to its value, up or down", "[plot]") {
+  const Rgb red{200, 10, 10}, green{10, 150, 10};
+  BarChart chart;
+  chart.title = "t";
+  chart.categories = {"legend here", "bars"};  // the first group stays empty under the legend
+  const double a = 0.9, b = -0.3;
+  chart.series = {{"a", {NAN, a}, red}, {"b", {NAN, b}, green}};
+  const RgbImage image = draw_bar_chart(chart);
+  // Each colour also fills a legend swatch: measure those on a chart with the same axes whose bars
+  // are drawn in a third colour.
+  BarChart legend_only = chart;
+  legend_only.series[0].values = {NAN, NAN};
+  legend_only.series[1].values = {NAN, NAN};
+  legend_only.series.push_back({"c", {a, b}, Rgb{0, 0, 200}});
+  const RgbImage legend_image = draw_bar_chart(legend_only);
+  const long red_bar = count_pixels(image, red) - count_pixels(legend_image, red);
+  const long green_bar = count_pixels(image, green) - count_pixels(legend_image, green);
+  INFO("bar pixels " << red_bar << " and " << green_bar);
+  REQUIRE(green_bar > 100);
+  CHECK(static_cast<double>(red_bar) / static_cast<double>(green_bar) == Approx(std::abs(a / b)).epsilon(0.05));
+}
+
+TEST_CASE("Value labels fit their bars when many series share a group", "[plot]") {
+  BarChart chart;
+  chart.title = "six models, four needles";
+  chart.categories = {"SB", "LMB", "AMB", "HMB"};
+  const Rgb probe{1, 2, 3};
+  for (int k = 0; k < 6; ++k)
+    chart.series.push_back({fmt::format("model {}", k), {-1.137, 0.56, 1.629, 2.578}, k == 3 ? probe : Rgb{100, 100, static_cast<unsigned char>(40 * k)}});
+  const RgbImage image = draw_bar_chart(chart);
+  TextWriter small(13);
+  const int label = small.width("+2.58");
+  INFO("label " << label << " px, image " << image.width << " px wide");
+  REQUIRE(label > 0);  // the font is installed (scripts/install-deps.sh)
+  CHECK(widest_run(image, probe) >= label);
+  CHECK(image.width > chart.width_px);  // 24 bars of a 900 px chart could not hold their labels
+}
