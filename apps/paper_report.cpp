@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fmt/format.h>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "apps/csv_table.h"
@@ -151,6 +152,16 @@ RgbImage groove_bars(const std::vector<NeedleRun>& runs, const std::vector<Paper
   return draw_bar_chart(chart);
 }
 
+// A facet's colour, the same in every needle's panel (the palette's order otherwise shifts with the
+// facets a needle has: the groove floor was green for SB and orange for the others).
+Rgb facet_colour(const std::string& facet, int fallback) {
+  static const std::map<std::string, int> palette_index = {{"top", 0},          {"bottom", 1},     {"side_pos", 2}, {"side_neg", 2},
+                                                           {"groove_floor", 3}, {"groove_wall", 4}, {"shaft", 5},   {"lancet_pos", 6},
+                                                           {"lancet_neg", 6},   {"base", 7}};
+  const auto it = palette_index.find(facet);
+  return plot_color(it != palette_index.end() ? it->second : fallback);
+}
+
 // One panel per needle: the y force the tissue puts on each facet that carries any.
 RgbImage facet_force_panels(const std::vector<NeedleRun>& runs) {
   const int panel_w = 760, panel_h = 480;
@@ -177,7 +188,7 @@ RgbImage facet_force_panels(const std::vector<NeedleRun>& runs) {
       s.label = c.substr(0, c.size() - suffix.size());
       s.x = x;
       s.y = y;
-      s.color = plot_color(color++);
+      s.color = facet_colour(s.label, color++);
       plot.series.push_back(s);
     }
     if (plot.series.empty()) continue;

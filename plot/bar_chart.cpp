@@ -9,6 +9,15 @@
 
 namespace needle {
 
+namespace {
+
+constexpr int kLegendRowPx = 22;
+
+// A legend entry: its swatch, its label and the gap to the next.
+int legend_entry_width(TextWriter& text, const std::string& label) { return 24 + text.width(label) + 28; }
+
+}  // namespace
+
 RgbImage draw_bar_chart(const BarChart& chart) {
   double y_min = 0, y_max = 0;  // bars start at zero, so zero is always on the axis
   bool any = false;
@@ -34,7 +43,15 @@ RgbImage draw_bar_chart(const BarChart& chart) {
       if (std::isfinite(v)) widest_label = std::max(widest_label, small.width(fmt::format(fmt::runtime(chart.value_format), v)));
   const int bars_width = static_cast<int>(std::ceil(std::max(1, categories) * std::max(1, bars) * (widest_label + 6) / 0.8));
   const int width_px = std::max(chart.width_px, left + right + bars_width);
-  RgbImage image(width_px, chart.height_px);
+  // The legend's rows below the chart, laid out as drawn at the end.
+  int legend_rows = chart.series.empty() ? 0 : 1;
+  int legend_x = left;
+  for (const BarSeries& s : chart.series) {
+    const int entry = legend_entry_width(text, s.label);
+    if (legend_x > left && legend_x + entry > width_px - right) legend_x = left, ++legend_rows;
+    legend_x += entry;
+  }
+  RgbImage image(width_px, chart.height_px + legend_rows * kLegendRowPx);
   const int w = width_px - left - right, h = chart.height_px - top - bottom;
   auto py = [&](double y) { return top + h - (y - y_min) / (y_max - y_min) * h; };
   title.draw(image, left, 32, chart.title, ink);
@@ -64,13 +81,14 @@ RgbImage draw_bar_chart(const BarChart& chart) {
   }
   image.line(left, top, left, top + h, ink, 1.2);
   image.line(left, py(0), left + w, py(0), ink, 1.2);
-  // Legend, top left inside the axes.
-  int y = top + 22;
+  // Legend under the category names, in rows as wide as the axes: never over a bar.
+  int x = left, y = chart.height_px + 8;
   for (const BarSeries& s : chart.series) {
-    const int x = left + 12;
+    const int entry = legend_entry_width(text, s.label);
+    if (x > left && x + entry > left + w) x = left, y += kLegendRowPx;
     image.fill_rect(x, y - 12, x + 16, y + 2, s.color);
     text.draw(image, x + 24, y, s.label, ink);
-    y += 22;
+    x += entry;
   }
   return image;
 }

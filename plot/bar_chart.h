@@ -1,6 +1,6 @@
 #pragma once
 // Grouped bar charts as PNG: one group of bars per category (a needle), one bar per series (ours,
-// experiment, LS-DYNA), a zero line, the value printed on each bar, a legend.
+// experiment, LS-DYNA), a zero line, the value printed on each bar, a legend below the axes.
 #include <string>
 #include <vector>
 

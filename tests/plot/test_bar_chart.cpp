@@ -71,3 +71,25 @@ TEST_CASE("Value labels fit their bars when many series share a group", "[plot]"
   CHECK(widest_run(image, probe) >= label);
   CHECK(image.width > chart.width_px);  // 24 bars of a 900 px chart could not hold their labels
 }
+
+TEST_CASE("The legend stays off the bars, however long its labels", "[plot]") {
+  // One bar filling the axes' full height under a legend label long enough to cross it: the column
+  // through the bar's middle is the bar's colour from the top of the axes down to the zero line.
+  const Rgb bar{20, 120, 20};
+  BarChart chart;
+  chart.title = "t";
+  chart.categories = {"one"};
+  chart.series = {{std::string(60, 'W'), {1.0}, bar}};
+  const RgbImage image = draw_bar_chart(chart);
+  int run = 0, longest = 0;
+  const int middle = image.width / 2 + 35;  // the axes start 90 px from the left, end 20 px from the right
+  for (int y = 0; y < image.height; ++y) {
+    const size_t p = 3 * (static_cast<size_t>(y) * image.width + middle);
+    run = (image.rgb[p] == bar[0] && image.rgb[p + 1] == bar[1] && image.rgb[p + 2] == bar[2]) ? run + 1 : 0;
+    longest = std::max(longest, run);
+  }
+  const int axes_height = chart.height_px - 50 - 60;
+  INFO("longest run " << longest << " px of an axes " << axes_height << " px high");
+  CHECK(longest >= axes_height - 4);
+  CHECK(image.height > chart.height_px);  // the legend's rows were added below
+}
