@@ -9,6 +9,7 @@
 
 #include "apps/json_file.h"
 #include "geometry/input_error.h"
+#include "plot/line_plot.h"
 
 namespace needle {
 using json = nlohmann::json;
@@ -104,8 +105,9 @@ std::vector<PaperTarget> evaluate_paper_targets(const std::vector<NeedleOutcome>
 
 Rgb compared_model_colour(int k) {
   if (k <= 0) return kOurs;
-  static const Rgb others[] = {{214, 39, 40}, {44, 160, 44}, {148, 103, 189}, {140, 86, 75}, {227, 119, 194}, {23, 190, 207}};
-  return others[static_cast<size_t>(k - 1) % std::size(others)];
+  // plot_color's palette without its blue (kOurs), orange (kLsDyna) and grey (near kExperiment).
+  static const int others[] = {1, 2, 4, 5, 6};
+  return plot_color(others[static_cast<size_t>(k - 1) % std::size(others)]);
 }
 
 }  // namespace needle

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
+#include <utility>
+#include <vector>
 
 #include "geometry/input_error.h"
 #include "plot/axis_ticks.h"
@@ -13,8 +15,19 @@ namespace {
 
 constexpr int kLegendRowPx = 22;
 
-// A legend entry: its swatch, its label and the gap to the next.
-int legend_entry_width(TextWriter& text, const std::string& label) { return 24 + text.width(label) + 28; }
+// Where each legend entry goes: rows as wide as the axes under the category names. {x, row} per
+// series.
+std::vector<std::pair<int, int>> legend_layout(TextWriter& text, const std::vector<BarSeries>& series, int left, int right_edge) {
+  std::vector<std::pair<int, int>> at;
+  int x = left, row = 0;
+  for (const BarSeries& s : series) {
+    const int entry = 24 + text.width(s.label) + 28;  // swatch, label, gap to the next
+    if (x > left && x + entry > right_edge) x = left, ++row;
+    at.emplace_back(x, row);
+    x += entry;
+  }
+  return at;
+}
 
 }  // namespace
 
@@ -43,14 +56,8 @@ RgbImage draw_bar_chart(const BarChart& chart) {
       if (std::isfinite(v)) widest_label = std::max(widest_label, small.width(fmt::format(fmt::runtime(chart.value_format), v)));
   const int bars_width = static_cast<int>(std::ceil(std::max(1, categories) * std::max(1, bars) * (widest_label + 6) / 0.8));
   const int width_px = std::max(chart.width_px, left + right + bars_width);
-  // The legend's rows below the chart, laid out as drawn at the end.
-  int legend_rows = chart.series.empty() ? 0 : 1;
-  int legend_x = left;
-  for (const BarSeries& s : chart.series) {
-    const int entry = legend_entry_width(text, s.label);
-    if (legend_x > left && legend_x + entry > width_px - right) legend_x = left, ++legend_rows;
-    legend_x += entry;
-  }
+  const std::vector<std::pair<int, int>> legend = legend_layout(text, chart.series, left, width_px - right);
+  const int legend_rows = legend.empty() ? 0 : legend.back().second + 1;
   RgbImage image(width_px, chart.height_px + legend_rows * kLegendRowPx);
   const int w = width_px - left - right, h = chart.height_px - top - bottom;
   auto py = [&](double y) { return top + h - (y - y_min) / (y_max - y_min) * h; };
@@ -81,14 +88,12 @@ RgbImage draw_bar_chart(const BarChart& chart) {
   }
   image.line(left, top, left, top + h, ink, 1.2);
   image.line(left, py(0), left + w, py(0), ink, 1.2);
-  // Legend under the category names, in rows as wide as the axes: never over a bar.
-  int x = left, y = chart.height_px + 8;
-  for (const BarSeries& s : chart.series) {
-    const int entry = legend_entry_width(text, s.label);
-    if (x > left && x + entry > left + w) x = left, y += kLegendRowPx;
-    image.fill_rect(x, y - 12, x + 16, y + 2, s.color);
-    text.draw(image, x + 24, y, s.label, ink);
-    x += entry;
+  // Legend under the category names: never over a bar.
+  for (size_t k = 0; k < legend.size(); ++k) {
+    const auto [x, row] = legend[k];
+    const int y = chart.height_px + 8 + row * kLegendRowPx;
+    image.fill_rect(x, y - 12, x + 16, y + 2, chart.series[k].color);
+    text.draw(image, x + 24, y, chart.series[k].label, ink);
   }
   return image;
 }
