@@ -329,6 +329,15 @@ void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
   }
   if (given(o.mesh_size_mm, "--mesh-size-mm")) scene.needle.mesh.size_mm = o.mesh_size_mm;
   if (o.no_needle_cut) scene.tissue.contact.cuts_bonds = false;
+  if (!std::isnan(o.tissue_nu)) {
+    scene.tissue.material.nu = o.tissue_nu;
+    scene.tissue.material.validate();
+  }
+  if (!std::isnan(o.tissue_friction)) {
+    NEEDLE_REQUIRE(std::isfinite(o.tissue_friction) && o.tissue_friction >= 0,
+                   fmt::format("--tissue-friction must be a number >= 0 (got {})", o.tissue_friction));
+    scene.tissue.friction = scene.tissue.contact.friction = o.tissue_friction;  // as the scene key tissue.friction sets both
+  }
 }
 
 void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
@@ -339,6 +348,8 @@ void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
   c->add_flag("--no-needle-cut", o.no_needle_cut,
               "The needle does not cut the bonds its body crosses; the tissue separates by bond failure alone, as in the paper's "
               "model (scene key tissue.contact.cuts_bonds)");
+  c->add_option("--tissue-nu", o.tissue_nu, "Tissue Poisson ratio (the paper's 0.45; scene key tissue.material.nu)");
+  c->add_option("--tissue-friction", o.tissue_friction, "Needle-tissue friction coefficient (the paper's 0.18; scene key tissue.friction)");
 }
 
 std::string scene_override_arguments(const SceneOverrides& o) {
@@ -348,6 +359,8 @@ std::string scene_override_arguments(const SceneOverrides& o) {
   if (!std::isnan(o.mesh_size_mm)) line += fmt::format(" --mesh-size-mm {}", o.mesh_size_mm);
   if (o.path_refinement != 0) line += fmt::format(" --path-refinement {}", o.path_refinement);
   if (o.no_needle_cut) line += " --no-needle-cut";
+  if (!std::isnan(o.tissue_nu)) line += fmt::format(" --tissue-nu {}", o.tissue_nu);
+  if (!std::isnan(o.tissue_friction)) line += fmt::format(" --tissue-friction {}", o.tissue_friction);
   return line;
 }
 

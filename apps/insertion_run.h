@@ -34,10 +34,12 @@ struct SceneOverrides {
   double travel_mm = std::nan(""), spacing_mm = std::nan(""), mesh_size_mm = std::nan("");
   int path_refinement = 0;  // 0: the scene's
   bool no_needle_cut = false;  // tissue separates by bond failure alone (the paper's model)
+  double tissue_nu = std::nan(""), tissue_friction = std::nan("");  // the card's Poisson ratio; needle-tissue friction
 };
 // InputError naming the flag for a value that is not a positive number.
 void apply_scene_overrides(Scene& scene, const SceneOverrides& overrides);
-// The flags run, paper and calibrate share: --travel-mm, --spacing-mm, --path-refinement, --no-needle-cut (each command
+// The flags run, paper and calibrate share: --travel-mm, --spacing-mm, --path-refinement, --no-needle-cut, --tissue-nu,
+// --tissue-friction (each command
 // adds --mesh-size-mm itself where it has it).
 void add_scene_override_options(CLI::App* command, SceneOverrides& overrides);
 // The flags that give these overrides again (each given value, with a leading space), for a command
