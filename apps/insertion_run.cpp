@@ -333,6 +333,10 @@ void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
     scene.tissue.material.nu = o.tissue_nu;
     scene.tissue.material.validate();
   }
+  if (!o.tissue_law.empty()) {
+    scene.tissue.material.law = tissue_law_from_name(o.tissue_law);
+    scene.tissue.material.validate();
+  }
   if (!std::isnan(o.tissue_friction)) {
     NEEDLE_REQUIRE(std::isfinite(o.tissue_friction) && o.tissue_friction >= 0,
                    fmt::format("--tissue-friction must be a number >= 0 (got {})", o.tissue_friction));
@@ -350,6 +354,9 @@ void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
               "model (scene key tissue.contact.cuts_bonds)");
   c->add_option("--tissue-nu", o.tissue_nu, "Tissue Poisson ratio (the paper's 0.45; scene key tissue.material.nu)");
   c->add_option("--tissue-friction", o.tissue_friction, "Needle-tissue friction coefficient (the paper's 0.18; scene key tissue.friction)");
+  c->add_option("--tissue-law", o.tissue_law,
+                "Tissue constitutive law: mat018 (the paper's card, default) or stiffening_elastic (E at small strain plus the "
+                "measured k eps^n; scene key tissue.material.law)");
 }
 
 std::string scene_override_arguments(const SceneOverrides& o) {
@@ -361,6 +368,7 @@ std::string scene_override_arguments(const SceneOverrides& o) {
   if (o.no_needle_cut) line += " --no-needle-cut";
   if (!std::isnan(o.tissue_nu)) line += fmt::format(" --tissue-nu {}", o.tissue_nu);
   if (!std::isnan(o.tissue_friction)) line += fmt::format(" --tissue-friction {}", o.tissue_friction);
+  if (!o.tissue_law.empty()) line += fmt::format(" --tissue-law {}", o.tissue_law);
   return line;
 }
 

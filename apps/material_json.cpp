@@ -9,6 +9,7 @@ namespace needle {
 TissueMaterial material_from_json(const nlohmann::json& json, const std::string& source, const TissueMaterial& defaults) {
   ObjectReader reader(json, "material", source);
   TissueMaterial m = defaults;
+  m.law = tissue_law_from_name(reader.text("law", tissue_law_name(m.law)));
   m.E_MPa = reader.number("E_MPa", m.E_MPa);
   m.nu = reader.number("nu", m.nu);
   m.density_g_per_cm3 = reader.number("density_g_per_cm3", m.density_g_per_cm3);
@@ -35,9 +36,13 @@ TissueMaterial read_material_file(const std::string& path) {
 }
 
 nlohmann::json material_to_json(const TissueMaterial& m) {
-  return {{"E_MPa", m.E_MPa}, {"nu", m.nu}, {"density_g_per_cm3", m.density_g_per_cm3}, {"k_MPa", m.k_MPa}, {"n", m.n},
+  nlohmann::json json = {{"E_MPa", m.E_MPa}, {"nu", m.nu}, {"density_g_per_cm3", m.density_g_per_cm3}, {"k_MPa", m.k_MPa}, {"n", m.n},
           {"rate_law", rate_law_name(m.rate_law)}, {"rate_C_per_ms", m.rate_C_per_ms}, {"rate_p", m.rate_p},
           {"max_rate_factor", m.max_rate_factor}};
+  // The paper's card is the default and is not named, so scenes written before the law existed read back
+  // the same (and their runs are reused).
+  if (m.law != TissueLaw::mat018) json["law"] = tissue_law_name(m.law);
+  return json;
 }
 
 }  // namespace needle

@@ -24,6 +24,7 @@ struct MaterialTestOptions {
   std::string material_file;
   std::optional<double> E_MPa, k_MPa, n, nu, density_g_per_cm3, rate_C_per_ms, rate_p;
   std::string rate_law;  // empty: from the card
+  std::string law;       // empty: from the card
   std::string lateral = "guided", stabilization = "penalty";
   UniaxialTestOptions test;
   int threads = 0;
@@ -46,6 +47,7 @@ void run_material_test(MaterialTestOptions& o) {
   if (o.rate_C_per_ms) material.rate_C_per_ms = *o.rate_C_per_ms;
   if (o.rate_p) material.rate_p = *o.rate_p;
   if (!o.rate_law.empty()) material.rate_law = rate_law_from_name(o.rate_law);
+  if (!o.law.empty()) material.law = tissue_law_from_name(o.law);
   material.validate();
   NEEDLE_REQUIRE(o.lateral == "guided" || o.lateral == "free", fmt::format("--lateral must be guided or free (got '{}')", o.lateral));
   o.test.guided_lateral = o.lateral == "guided";
@@ -65,7 +67,7 @@ void run_material_test(MaterialTestOptions& o) {
   if (o.json_output) {
     const nlohmann::json report = {
         {"material", material_to_json(material)},
-        {"yield_strain", material.yield_strain()},
+        {"yield_strain", material.law == TissueLaw::mat018 ? nlohmann::json(material.yield_strain()) : nlohmann::json(nullptr)},
         {"strain_rate_per_ms", o.test.strain_rate_per_ms},
         {"rate_factor", material.rate_factor(o.test.strain_rate_per_ms)},
         {"lateral", o.lateral},
@@ -102,8 +104,11 @@ void run_material_test(MaterialTestOptions& o) {
   plot.x_label = "true strain";
   plot.y_label = "true stress (MPa)";
   // The input law on a fine grid, the specimen's curve as points.
-  PlotSeries law{fmt::format("input law (closed-form MAT_018), rate law {} at {} /ms", rate_law_name(material.rate_law),
-                             o.test.strain_rate_per_ms), {}, {}, plot_color(1), true, false};
+  PlotSeries law{material.law == TissueLaw::mat018
+                     ? fmt::format("input law (closed-form MAT_018), rate law {} at {} /ms", rate_law_name(material.rate_law),
+                                   o.test.strain_rate_per_ms)
+                     : std::string("input law (closed-form stiffening elastic: 3 G eps + k eps^n)"),
+                 {}, {}, plot_color(1), true, false};
   for (int k = 0; k <= 200; ++k) {
     const double e = o.test.max_strain * k / 200.0;
     law.x.push_back(e);
@@ -132,6 +137,7 @@ void add_material_test_command(CLI::App& app) {
   cmd->add_option("--nu", o->nu, "Poisson's ratio (default 0.45)");
   cmd->add_option("--density-g-per-cm3", o->density_g_per_cm3, "Density (default 0.98)");
   cmd->add_option("--rate-law", o->rate_law, "Cowper-Symonds factor: on (= plausible, exponent p), printed (exponent 1/p), off");
+  cmd->add_option("--law", o->law, "Constitutive law: mat018 (the paper's card) or stiffening_elastic (E at small strain plus k eps^n)");
   cmd->add_option("--rate-C-per-ms", o->rate_C_per_ms, "Cowper-Symonds C (default 0.1 /ms)");
   cmd->add_option("--rate-p", o->rate_p, "Cowper-Symonds p (default 0.1)");
   cmd->add_option("--max-strain", o->test.max_strain, "Largest true strain of the test")->capture_default_str();

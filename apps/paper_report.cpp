@@ -72,6 +72,9 @@ NeedleRun read_run(const std::string& out_dir, const std::string& name) {
       r.needle_cuts = t.contains("contact") && t["contact"].value("cuts_bonds", false);
       r.tissue_resolution += fmt::format(" ({} particles); the needle {} the bonds its body passes through", r.particles,
                                          r.needle_cuts ? "cuts" : "does not cut");
+      // The paper's card is the default and goes unnamed; another law is said.
+      if (t.contains("material") && t["material"].value("law", std::string("mat018")) == "stiffening_elastic")
+        r.tissue_resolution += "; the tissue stiffens as measured (stiffening_elastic: 3 G eps + k eps^n)";
     }
   }
   r.history = read_csv_table((fs::path(r.folder) / "history.csv").string());

@@ -30,7 +30,9 @@ NeedleTissueContact::NeedleTissueContact(const ContactSurface& surface, const Ti
   stiffness_.resize(n);
   mass_ = particles.mass_g;
   stable_dt_ms_ = std::numeric_limits<double>::infinity();
-  const double modulus = material.p_wave_modulus_MPa();
+  // The penalty follows the tissue at a strain the needle imposes (1): the elastic modulus for the
+  // paper's card, the stiffened tangent for a stiffening law.
+  const double modulus = material.tangent_p_wave_modulus_MPa(1.0);
   for (size_t i = 0; i < n; ++i) {
     const double h = particles.spacing_mm[i];
     stiffness_[i] = options_.stiffness_factor * modulus * particles.reference_volume_mm3[i] / (h * h);

@@ -309,12 +309,15 @@ void SpgTissue::detach(size_t s) {
 
 double SpgTissue::stable_time_step_ms() const {
   const double factor = options_.stabilization == Stabilization::penalty ? 1.0 + 4.0 * options_.stabilization_coefficient : 1.0;
-  const double wave_speed = std::sqrt(material_.p_wave_modulus_MPa() * factor / material_.density_g_per_mm3());
   double shortest = std::numeric_limits<double>::infinity();  // current length of the shortest support
+  double largest_strain = 0;  // the stiffest point of a stiffening law
   for (std::int64_t i = 0; i < p_.size(); ++i) {
     const size_t s = static_cast<size_t>(i);
-    if (rk_.valid[s]) shortest = std::min(shortest, stable_length_mm_[s] * min_stretch_[s]);
+    if (!rk_.valid[s]) continue;
+    shortest = std::min(shortest, stable_length_mm_[s] * min_stretch_[s]);
+    largest_strain = std::max(largest_strain, p_.effective_strain[s] - p_.plastic_strain[s]);
   }
+  const double wave_speed = std::sqrt(material_.tangent_p_wave_modulus_MPa(largest_strain) * factor / material_.density_g_per_mm3());
   return options_.cfl * shortest / wave_speed;
 }
 

@@ -15,6 +15,14 @@ RateLaw rate_law_from_name(const std::string& name) {
   throw InputError(fmt::format("rate law '{}' is not one of off, on (= plausible), printed", name));
 }
 
+TissueLaw tissue_law_from_name(const std::string& name) {
+  if (name == "mat018") return TissueLaw::mat018;
+  if (name == "stiffening_elastic") return TissueLaw::stiffening_elastic;
+  throw InputError(fmt::format("tissue law '{}' is not one of mat018, stiffening_elastic", name));
+}
+
+std::string tissue_law_name(TissueLaw law) { return law == TissueLaw::stiffening_elastic ? "stiffening_elastic" : "mat018"; }
+
 std::string rate_law_name(RateLaw law) {
   switch (law) {
     case RateLaw::off: return "off";
@@ -37,12 +45,23 @@ void TissueMaterial::validate() const {
   NEEDLE_REQUIRE(finite_positive(rate_p), fmt::format("rate law p must be positive (got {})", rate_p));
   NEEDLE_REQUIRE(std::isfinite(max_rate_factor) && max_rate_factor >= 1.0,
                  fmt::format("max_rate_factor must be >= 1 (got {})", max_rate_factor));
+  if (law == TissueLaw::stiffening_elastic) return;  // no yield strain to check
   const double eps_yp = yield_strain();
   NEEDLE_REQUIRE(std::isfinite(eps_yp) && eps_yp < 100.0,
                  fmt::format("E = {} MPa with k = {} MPa, n = {} gives a yield strain {:.3g}: the card never yields", E_MPa, k_MPa, n, eps_yp));
 }
 
 double TissueMaterial::yield_strain() const { return std::pow(E_MPa / k_MPa, 1.0 / (n - 1.0)); }
+
+double TissueMaterial::equivalent_stress_MPa(double eps) const {
+  return 3 * shear_modulus_MPa() * eps + k_MPa * std::pow(std::max(eps, 0.0), n);
+}
+
+double TissueMaterial::tangent_p_wave_modulus_MPa(double effective_strain) const {
+  if (law == TissueLaw::mat018) return p_wave_modulus_MPa();
+  const double tangent_shear = shear_modulus_MPa() + k_MPa * n * std::pow(std::max(effective_strain, 0.0), n - 1.0) / 3.0;
+  return bulk_modulus_MPa() + 4.0 / 3.0 * tangent_shear;
+}
 
 double TissueMaterial::rate_factor(double strain_rate_per_ms, bool* capped) const {
   if (capped) *capped = false;
@@ -84,15 +103,18 @@ StressUpdate update_stress(const TissueMaterial& m, const MaterialPoint& state, 
     rate = std::sqrt(2.0 / 3.0 * d.squaredNorm()) / dt_ms;
   }
   bool capped = false;
-  const double factor = m.rate_factor(rate, &capped);
+  const double factor = m.law == TissueLaw::mat018 ? m.rate_factor(rate, &capped) : 1.0;
 
   const double mu = m.shear_modulus_MPa(), lambda = m.lame_lambda_MPa();
   const double volumetric = h.sum();
   const Eigen::Vector3d h_dev = h.array() - volumetric / 3.0;
-  Eigen::Vector3d s = 2 * mu * h_dev;  // principal deviatoric Cauchy stress
+  const double eps_eq = std::sqrt(2.0 / 3.0 * h_dev.squaredNorm());
+  // Secant shear modulus: q(eps) / (3 eps); mu itself for the linear card (and at eps = 0).
+  const double secant_mu = m.law == TissueLaw::stiffening_elastic && eps_eq > 0 ? m.equivalent_stress_MPa(eps_eq) / (3 * eps_eq) : mu;
+  Eigen::Vector3d s = 2 * secant_mu * h_dev;  // principal deviatoric Cauchy stress
   const double q_trial = std::sqrt(1.5 * s.squaredNorm());
   double eps_p = state.plastic_strain;
-  if (q_trial > m.yield_stress_MPa(eps_p, factor)) {
+  if (m.law == TissueLaw::mat018 && q_trial > m.yield_stress_MPa(eps_p, factor)) {
     // Radial return: q_trial - 3 mu dg = sigma_y(eps_p + dg); Newton with bisection bounds.
     double lo = 0.0, hi = q_trial / (3 * mu), dg = 0.0;
     for (int it = 0; it < 60; ++it) {
@@ -122,6 +144,18 @@ StressUpdate update_stress(const TissueMaterial& m, const MaterialPoint& state, 
 }
 
 double uniaxial_true_stress_MPa(const TissueMaterial& m, double true_strain, double strain_rate_per_ms) {
+  if (m.law == TissueLaw::stiffening_elastic) {
+    // Uniaxial stress: h = (e, -t, -t) with sigma = q(2/3 (e + t)) and sigma / 3 = K (e - 2 t); solve the
+    // lateral contraction t by bisection (q rises with t, the volumetric pressure falls).
+    const double e = std::abs(true_strain), K = m.bulk_modulus_MPa();
+    double lo = -e, hi = e;
+    for (int it = 0; it < 200; ++it) {
+      const double t = 0.5 * (lo + hi);
+      if (m.equivalent_stress_MPa(2.0 / 3.0 * (e + t)) > 3 * K * (e - 2 * t)) hi = t; else lo = t;
+    }
+    const double stress = 3 * K * (e - lo - hi);  // 3 K (e - 2 t) at t = (lo + hi) / 2
+    return true_strain < 0 ? -stress : stress;
+  }
   const double factor = m.rate_factor(strain_rate_per_ms);
   const double eps = std::abs(true_strain);
   const double elastic = m.E_MPa * eps;

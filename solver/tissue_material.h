@@ -20,10 +20,24 @@ namespace needle {
 
 enum class RateLaw { off, plausible, printed };
 
+// Which constitutive law the card follows.
+// - mat018: the paper's card (LS-DYNA MAT_018), linear to eps_yp, then plastic on k eps^n. With n > 1
+//   it is nearly linear at every strain: its curve never follows the measured k eps^n, which stiffens.
+// - stiffening_elastic: hyperelastic in the Hencky strain, with the equivalent stress
+//   q(eps) = 3 G eps + k eps^n of the equivalent log strain eps (G from E and nu): small-strain modulus E,
+//   then the paper's measured power law on top, so the gel stiffens as in its compression test.
+//   Volumetric part linear, K from E and nu. No plasticity; the rate law does not apply (it scales a
+//   yield stress, and this law has none).
+enum class TissueLaw { mat018, stiffening_elastic };
+
+TissueLaw tissue_law_from_name(const std::string& name);  // "mat018", "stiffening_elastic"
+std::string tissue_law_name(TissueLaw law);
+
 RateLaw rate_law_from_name(const std::string& name);  // "off", "on"/"plausible", "printed"
 std::string rate_law_name(RateLaw law);
 
 struct TissueMaterial {
+  TissueLaw law = TissueLaw::mat018;
   double E_MPa = 0.665;
   double nu = 0.45;
   double density_g_per_cm3 = 0.98;
@@ -40,7 +54,14 @@ struct TissueMaterial {
   double density_g_per_mm3() const { return density_g_per_cm3 * 1e-3; }
   double shear_modulus_MPa() const { return E_MPa / (2 * (1 + nu)); }
   double lame_lambda_MPa() const { return E_MPa * nu / ((1 + nu) * (1 - 2 * nu)); }
-  double p_wave_modulus_MPa() const { return lame_lambda_MPa() + 2 * shear_modulus_MPa(); }
+  double p_wave_modulus_MPa() const { return lame_lambda_MPa() + 2 * shear_modulus_MPa(); }  // at zero strain
+  double bulk_modulus_MPa() const { return E_MPa / (3 * (1 - 2 * nu)); }
+  // The P-wave modulus of the tangent at an effective strain: the stable step's wave speed. For mat018
+  // the elastic one (plastic flow only softens); for stiffening_elastic K + 4/3 dq/deps / 3.
+  double tangent_p_wave_modulus_MPa(double effective_strain) const;
+  // stiffening_elastic: q(eps) = 3 G eps + k eps^n, the equivalent (von Mises) stress at an equivalent
+  // log strain eps >= 0.
+  double equivalent_stress_MPa(double equivalent_strain) const;
   double yield_strain() const;  // eps_yp
   // Rate factor at an effective strain rate (1/ms); `capped` set when the cap applied.
   double rate_factor(double strain_rate_per_ms, bool* capped = nullptr) const;

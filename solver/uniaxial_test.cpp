@@ -141,6 +141,7 @@ UniaxialCurve run_uniaxial_test(const TissueMaterial& material, const UniaxialTe
   };
   record();
   const double end_time = o.max_strain / rate;
+  double previous_dt_ms = 0;
   for (int k = 1; k < o.samples; ++k) {
     const double sample_time = end_time * k / (o.samples - 1);
     while (dynamics.time_ms() < sample_time - 1e-12 * end_time) {
@@ -148,9 +149,17 @@ UniaxialCurve run_uniaxial_test(const TissueMaterial& material, const UniaxialTe
       if (o.guided_lateral) {
         // Servo: the lateral log-strain rate that would cancel the mean lateral stress over the next
         // step through the elastic response (lateral stiffness 2 (lambda + mu)), relaxed by half.
+        // A stiffening law's tangent takes the place of the elastic constants as it stiffens.
+        const double strain = rate * dynamics.time_ms();
+        const double mu_t = 0.75 * (material.tangent_p_wave_modulus_MPa(strain) - material.bulk_modulus_MPa());
+        const double lambda_t = material.law == TissueLaw::mat018 ? lambda_lame : material.bulk_modulus_MPa() - 2.0 / 3.0 * mu_t;
+        const double mu_servo = material.law == TissueLaw::mat018 ? mu : mu_t;
         servo->stretch *= std::exp(servo->log_rate_per_ms * step.dt_ms);
-        servo->log_rate_per_ms = -(lambda_lame * rate + 0.5 * mean_lateral_stress() / step.dt_ms) / (2 * (lambda_lame + mu));
+        // A step cut short to land on a sample would divide the correction by a tiny dt: keep the rate.
+        if (step.dt_ms >= 0.5 * previous_dt_ms)
+          servo->log_rate_per_ms = -(lambda_t * rate + 0.5 * mean_lateral_stress() / step.dt_ms) / (2 * (lambda_t + mu_servo));
       }
+      previous_dt_ms = step.dt_ms;
       curve.rate_factor_capped += step.rate_factor_capped;
       curve.max_energy_error = std::max(curve.max_energy_error, dynamics.energy().relative_error());
     }

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "apps/csv_table.h"
 #include "apps/scene.h"
 #include "cli_run.h"
 #include "geometry/input_error.h"
@@ -242,7 +243,8 @@ TEST_CASE("needle run: no needle, two needles or a bad number exit 2 with one li
                                  "run --preset XX --out " + (dir / "a").string(),
                                  "run --preset SB --path-refinement 9 --out " + (dir / "a").string(),
                                  "run --preset SB --tissue-nu 0.5 --out " + (dir / "a").string(),
-                                 "run --preset SB --tissue-friction -0.1 --out " + (dir / "a").string()}) {
+                                 "run --preset SB --tissue-friction -0.1 --out " + (dir / "a").string(),
+                                 "run --preset SB --tissue-law neo_hookean --out " + (dir / "a").string()}) {
     const auto r = run(args, true);
     INFO(args << " -> " << r.out);
     CHECK(r.exit_code == 2);
@@ -269,4 +271,27 @@ TEST_CASE("needle run --no-needle-cut: the tissue separates by bond failure alon
   CHECK(cut_summary["bonds_cut_by_needle"].get<long>() > 0);
   CHECK(plain_summary["bonds_cut_by_needle"].get<long>() == 0);
   CHECK(plain_summary["status"] == "finished");
+}
+
+TEST_CASE("needle run --tissue-law stiffening_elastic: the scene says so and the stiffened tissue resists harder", "[apps][lspg][gmsh]") {
+  // The same short insertion at the same E under both laws: the stiffening law adds k eps^n to the same
+  // small-strain modulus, so the tissue's reaction on the rod must be larger. The default law is not
+  // written into the effective scene (stored scenes and runs stay as they were).
+  auto run_variant = [](const std::string& name, const std::string& flags) {
+    const fs::path dir = fresh_folder(name);
+    const auto r = run_rod_into_block(dir, R"({"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4})", 0.8, 0, "--tissue-E-MPa 0.03 " + flags);
+    INFO(r.out);
+    REQUIRE(r.exit_code == 0);
+    std::ifstream scene_file(dir / "run" / "scene.json");
+    const nlohmann::json scene = nlohmann::json::parse(scene_file);
+    const needle::CsvTable history = needle::read_csv_table((dir / "run" / "history.csv").string());
+    return std::pair{scene, std::abs(history.column("contact_force_x_N").back())};
+  };
+  const auto [card_scene, card_drag_N] = run_variant("law_card", "");
+  const auto [stiff_scene, stiff_drag_N] = run_variant("law_stiffening", "--tissue-law stiffening_elastic");
+  CHECK_FALSE(card_scene["tissue"]["material"].contains("law"));
+  CHECK(stiff_scene["tissue"]["material"]["law"] == "stiffening_elastic");
+  INFO("drag: card " << card_drag_N << " N, stiffening " << stiff_drag_N << " N");
+  CHECK(card_drag_N > 0);
+  CHECK(stiff_drag_N > 1.2 * card_drag_N);
 }
