@@ -141,6 +141,21 @@ TEST_CASE("needle paper --report-only: a wrong sign, a large error and a wrong g
   CHECK(read_text(dir / "report.md").find("**not met**") != std::string::npos);
 }
 
+TEST_CASE("needle paper --report-only names the tissue law when it is not the paper's card", "[apps][paper]") {
+  const fs::path dir = fresh("law");
+  for (const char* name : {"SB", "LMB", "AMB", "HMB"}) {
+    write_run(dir, name, {-1.1, 0.9});
+    const json scene = {{"tissue", {{"spacing_mm", 0.4}, {"contact", {{"cuts_bonds", true}}}, {"material", {{"law", "stiffening_elastic"}}}}}};
+    std::ofstream(dir / "runs" / name / "scene.json") << scene.dump(2);
+  }
+  const auto result = run("paper --report-only --no-tips --quiet --out " + dir.string(), true);
+  INFO(result.out);
+  REQUIRE(result.exit_code == 0);
+  CHECK(read_text(dir / "report.md").find("the needle cuts the bonds its body passes through; the tissue stiffens as measured "
+                                          "(stiffening_elastic: 3 G eps + k eps^n)") != std::string::npos);
+  CHECK(read_json(dir / "results.json")["tissue"].get<std::string>().find("stiffening_elastic") != std::string::npos);
+}
+
 TEST_CASE("needle paper refuses missing runs and unknown needles with one message and exit 2", "[apps][paper]") {
   const fs::path dir = fresh("bad");
   auto r = run("paper --report-only --no-tips --out " + dir.string(), true);
