@@ -18,6 +18,7 @@
 #include "geometry/tip_report.h"
 #include "plot/bar_chart.h"
 #include "plot/line_plot.h"
+#include "solver/tissue_material.h"
 
 namespace needle {
 namespace fs = std::filesystem;
@@ -73,7 +74,8 @@ NeedleRun read_run(const std::string& out_dir, const std::string& name) {
       r.tissue_resolution += fmt::format(" ({} particles); the needle {} the bonds its body passes through", r.particles,
                                          r.needle_cuts ? "cuts" : "does not cut");
       // The paper's card is the default and goes unnamed; another law is said.
-      if (t.contains("material") && t["material"].value("law", std::string("mat018")) == "stiffening_elastic")
+      if (t.contains("material") &&
+          tissue_law_from_name(t["material"].value("law", tissue_law_name(TissueLaw::mat018))) == TissueLaw::stiffening_elastic)
         r.tissue_resolution += "; the tissue stiffens as measured (stiffening_elastic: 3 G eps + k eps^n)";
     }
   }

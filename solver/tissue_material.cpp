@@ -57,10 +57,14 @@ double TissueMaterial::equivalent_stress_MPa(double eps) const {
   return 3 * shear_modulus_MPa() * eps + k_MPa * std::pow(std::max(eps, 0.0), n);
 }
 
+double TissueMaterial::tangent_shear_modulus_MPa(double effective_strain) const {
+  if (law == TissueLaw::mat018) return shear_modulus_MPa();
+  return shear_modulus_MPa() + k_MPa * n * std::pow(std::max(effective_strain, 0.0), n - 1.0) / 3.0;
+}
+
 double TissueMaterial::tangent_p_wave_modulus_MPa(double effective_strain) const {
-  if (law == TissueLaw::mat018) return p_wave_modulus_MPa();
-  const double tangent_shear = shear_modulus_MPa() + k_MPa * n * std::pow(std::max(effective_strain, 0.0), n - 1.0) / 3.0;
-  return bulk_modulus_MPa() + 4.0 / 3.0 * tangent_shear;
+  if (law == TissueLaw::mat018) return p_wave_modulus_MPa();  // the same value, kept to the last bit for stored runs
+  return bulk_modulus_MPa() + 4.0 / 3.0 * tangent_shear_modulus_MPa(effective_strain);
 }
 
 double TissueMaterial::rate_factor(double strain_rate_per_ms, bool* capped) const {

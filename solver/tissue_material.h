@@ -56,8 +56,10 @@ struct TissueMaterial {
   double lame_lambda_MPa() const { return E_MPa * nu / ((1 + nu) * (1 - 2 * nu)); }
   double p_wave_modulus_MPa() const { return lame_lambda_MPa() + 2 * shear_modulus_MPa(); }  // at zero strain
   double bulk_modulus_MPa() const { return E_MPa / (3 * (1 - 2 * nu)); }
-  // The P-wave modulus of the tangent at an effective strain: the stable step's wave speed. For mat018
-  // the elastic one (plastic flow only softens); for stiffening_elastic K + 4/3 dq/deps / 3.
+  // The tangent shear modulus at an (elastic) effective strain, dq/deps / 3: G for mat018 (plastic flow
+  // only softens), G + k n eps^(n-1) / 3 for stiffening_elastic.
+  double tangent_shear_modulus_MPa(double effective_strain) const;
+  // K + 4/3 of that: the stable step's wave speed (the elastic P-wave modulus for mat018).
   double tangent_p_wave_modulus_MPa(double effective_strain) const;
   // stiffening_elastic: q(eps) = 3 G eps + k eps^n, the equivalent (von Mises) stress at an equivalent
   // log strain eps >= 0.

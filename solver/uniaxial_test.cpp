@@ -149,15 +149,13 @@ UniaxialCurve run_uniaxial_test(const TissueMaterial& material, const UniaxialTe
       if (o.guided_lateral) {
         // Servo: the lateral log-strain rate that would cancel the mean lateral stress over the next
         // step through the elastic response (lateral stiffness 2 (lambda + mu)), relaxed by half.
-        // A stiffening law's tangent takes the place of the elastic constants as it stiffens.
-        const double strain = rate * dynamics.time_ms();
-        const double mu_t = 0.75 * (material.tangent_p_wave_modulus_MPa(strain) - material.bulk_modulus_MPa());
-        const double lambda_t = material.law == TissueLaw::mat018 ? lambda_lame : material.bulk_modulus_MPa() - 2.0 / 3.0 * mu_t;
-        const double mu_servo = material.law == TissueLaw::mat018 ? mu : mu_t;
+        // The tangent's constants, which a stiffening law raises as it stiffens (the elastic ones for MAT_018).
+        const double mu_t = material.tangent_shear_modulus_MPa(rate * dynamics.time_ms());
+        const double lambda_t = material.bulk_modulus_MPa() - 2.0 / 3.0 * mu_t;
         servo->stretch *= std::exp(servo->log_rate_per_ms * step.dt_ms);
         // A step cut short to land on a sample would divide the correction by a tiny dt: keep the rate.
         if (step.dt_ms >= 0.5 * previous_dt_ms)
-          servo->log_rate_per_ms = -(lambda_t * rate + 0.5 * mean_lateral_stress() / step.dt_ms) / (2 * (lambda_t + mu_servo));
+          servo->log_rate_per_ms = -(lambda_t * rate + 0.5 * mean_lateral_stress() / step.dt_ms) / (2 * (lambda_t + mu_t));
       }
       previous_dt_ms = step.dt_ms;
       curve.rate_factor_capped += step.rate_factor_capped;
