@@ -317,10 +317,10 @@ void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
     NEEDLE_REQUIRE(std::isnan(v) || (std::isfinite(v) && v > 0), fmt::format("{} must be a positive number (got {})", flag, v));
     return !std::isnan(v);
   };
-  if (given(o.travel_mm, "--travel-mm")) {
-    scene.motion.travel_mm = o.travel_mm;
-    scene.motion.validate("--travel-mm");
-  }
+  const bool travel_given = given(o.travel_mm, "--travel-mm"), speed_given = given(o.speed_m_per_s, "--speed-m-per-s");
+  if (travel_given) scene.motion.travel_mm = o.travel_mm;
+  if (speed_given) scene.motion.speed_mm_per_ms = o.speed_m_per_s;  // m/s = mm/ms
+  if (travel_given || speed_given) scene.motion.validate(travel_given ? "--travel-mm" : "--speed-m-per-s");
   if (given(o.spacing_mm, "--spacing-mm")) scene.tissue.spacing_mm = o.spacing_mm;
   if (o.path_refinement != 0) {
     NEEDLE_REQUIRE(o.path_refinement >= 1 && o.path_refinement <= 8,
@@ -357,6 +357,9 @@ void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
   c->add_option("--tissue-law", o.tissue_law,
                 "Tissue constitutive law: mat018 (the paper's card, default) or stiffening_elastic (E at small strain plus the "
                 "measured k eps^n; scene key tissue.material.law)");
+  c->add_option("--speed-m-per-s", o.speed_m_per_s,
+                "Insertion speed after the 0.75 ms ramp (the paper's model 8 m/s; its experiment fired at about 4 m/s; "
+                "scene key motion.speed_m_per_s)");
 }
 
 std::string scene_override_arguments(const SceneOverrides& o) {
@@ -369,6 +372,7 @@ std::string scene_override_arguments(const SceneOverrides& o) {
   if (!std::isnan(o.tissue_nu)) line += fmt::format(" --tissue-nu {}", o.tissue_nu);
   if (!std::isnan(o.tissue_friction)) line += fmt::format(" --tissue-friction {}", o.tissue_friction);
   if (!o.tissue_law.empty()) line += fmt::format(" --tissue-law {}", o.tissue_law);
+  if (!std::isnan(o.speed_m_per_s)) line += fmt::format(" --speed-m-per-s {}", o.speed_m_per_s);
   return line;
 }
 

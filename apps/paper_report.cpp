@@ -18,6 +18,7 @@
 #include "geometry/tip_report.h"
 #include "plot/bar_chart.h"
 #include "plot/line_plot.h"
+#include "solver/insertion_profile.h"
 #include "solver/tissue_material.h"
 
 namespace needle {
@@ -78,6 +79,10 @@ NeedleRun read_run(const std::string& out_dir, const std::string& name) {
           tissue_law_from_name(t["material"].value("law", tissue_law_name(TissueLaw::mat018))) == TissueLaw::stiffening_elastic)
         r.tissue_resolution += "; the tissue stiffens as measured (stiffening_elastic: 3 G eps + k eps^n)";
     }
+    // The paper's model drives at 8 m/s and goes unnamed; another speed (its experiment's 4 m/s) is said.
+    const double speed_m_per_s = scene.contains("motion") ? scene["motion"].value("speed_m_per_s", 8.0) : 8.0;
+    if (speed_m_per_s != InsertionProfile{}.speed_mm_per_ms)
+      r.tissue_resolution += fmt::format("; the needle is driven at {:g} m/s (the paper's model: 8)", speed_m_per_s);
   }
   r.history = read_csv_table((fs::path(r.folder) / "history.csv").string());
   r.facets = read_csv_table((fs::path(r.folder) / "facet_forces.csv").string());

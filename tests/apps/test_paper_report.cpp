@@ -141,19 +141,22 @@ TEST_CASE("needle paper --report-only: a wrong sign, a large error and a wrong g
   CHECK(read_text(dir / "report.md").find("**not met**") != std::string::npos);
 }
 
-TEST_CASE("needle paper --report-only names the tissue law when it is not the paper's card", "[apps][paper]") {
+TEST_CASE("needle paper --report-only names the tissue law and the drive speed when they are not the paper's model", "[apps][paper]") {
   const fs::path dir = fresh("law");
   for (const char* name : {"SB", "LMB", "AMB", "HMB"}) {
     write_run(dir, name, {-1.1, 0.9});
-    const json scene = {{"tissue", {{"spacing_mm", 0.4}, {"contact", {{"cuts_bonds", true}}}, {"material", {{"law", "stiffening_elastic"}}}}}};
+    const json scene = {{"tissue", {{"spacing_mm", 0.4}, {"contact", {{"cuts_bonds", true}}}, {"material", {{"law", "stiffening_elastic"}}}}},
+                        {"motion", {{"speed_m_per_s", 4.0}}}};
     std::ofstream(dir / "runs" / name / "scene.json") << scene.dump(2);
   }
   const auto result = run("paper --report-only --no-tips --quiet --out " + dir.string(), true);
   INFO(result.out);
   REQUIRE(result.exit_code == 0);
   CHECK(read_text(dir / "report.md").find("the needle cuts the bonds its body passes through; the tissue stiffens as measured "
-                                          "(stiffening_elastic: 3 G eps + k eps^n)") != std::string::npos);
-  CHECK(read_json(dir / "results.json")["tissue"].get<std::string>().find("stiffening_elastic") != std::string::npos);
+                                          "(stiffening_elastic: 3 G eps + k eps^n); the needle is driven at 4 m/s") != std::string::npos);
+  const std::string tissue = read_json(dir / "results.json")["tissue"].get<std::string>();
+  CHECK(tissue.find("stiffening_elastic") != std::string::npos);
+  CHECK(tissue.find("driven at 4 m/s") != std::string::npos);
 }
 
 TEST_CASE("needle paper refuses missing runs and unknown needles with one message and exit 2", "[apps][paper]") {

@@ -2,6 +2,7 @@
 // contents checked against the solver's own invariants, and bad scenes refused with file, line and
 // key, leaving no folder behind. Also `needle stiffness --json`.
 #include <catch2/catch.hpp>
+#include <fmt/format.h>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -244,7 +245,9 @@ TEST_CASE("needle run: no needle, two needles or a bad number exit 2 with one li
                                  "run --preset SB --path-refinement 9 --out " + (dir / "a").string(),
                                  "run --preset SB --tissue-nu 0.5 --out " + (dir / "a").string(),
                                  "run --preset SB --tissue-friction -0.1 --out " + (dir / "a").string(),
-                                 "run --preset SB --tissue-law neo_hookean --out " + (dir / "a").string()}) {
+                                 "run --preset SB --tissue-law neo_hookean --out " + (dir / "a").string(),
+                                 "run --preset SB --speed-m-per-s 0 --out " + (dir / "a").string(),
+                                 "run --preset SB --speed-m-per-s 100 --out " + (dir / "a").string()}) {
     const auto r = run(args, true);
     INFO(args << " -> " << r.out);
     CHECK(r.exit_code == 2);
@@ -294,4 +297,29 @@ TEST_CASE("needle run --tissue-law stiffening_elastic: the scene says so and the
   INFO("drag: card " << card_drag_N << " N, stiffening " << stiff_drag_N << " N");
   CHECK(card_drag_N > 0);
   CHECK(stiff_drag_N > 1.2 * card_drag_N);
+}
+
+TEST_CASE("needle run --speed-m-per-s: the scene says so and the drive ends when the closed-form profile does", "[apps][lspg][gmsh]") {
+  // The rod's scene ramps 0 -> v in 0.02 ms, then runs at v to 0.8 mm: it ends at
+  // t = 0.02 + (0.8 - v 0.02 / 2) / v ms. Halving the speed must nearly double the run's simulated time.
+  auto end_of_run = [](const std::string& name, double speed_m_per_s) {
+    const fs::path dir = fresh_folder(name);
+    const auto r = run_rod_into_block(dir, R"({"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4})", 0.8, 0,
+                                      fmt::format("--speed-m-per-s {}", speed_m_per_s));
+    INFO(r.out);
+    REQUIRE(r.exit_code == 0);
+    std::ifstream scene_file(dir / "run" / "scene.json"), summary_file(dir / "run" / "summary.json");
+    const nlohmann::json scene = nlohmann::json::parse(scene_file), summary = nlohmann::json::parse(summary_file);
+    CHECK(scene["motion"]["speed_m_per_s"].get<double>() == speed_m_per_s);
+    CHECK(summary["status"] == "finished");
+    CHECK(summary["insertion_mm"].get<double>() == Approx(0.8).epsilon(1e-6));
+    const needle::CsvTable history = needle::read_csv_table((dir / "run" / "history.csv").string());
+    return history.column("time_ms").back();
+  };
+  for (const double v : {8.0, 4.0}) {
+    const double expected_ms = 0.02 + (0.8 - 0.5 * v * 0.02) / v;
+    const double end_ms = end_of_run(fmt::format("speed_{}", v), v);
+    INFO("v " << v << " m/s: history ends at " << end_ms << " ms, profile " << expected_ms << " ms");
+    CHECK(end_ms == Approx(expected_ms).epsilon(1e-6));
+  }
 }
