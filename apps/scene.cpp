@@ -63,6 +63,7 @@ void read_motion(SceneObject o, Scene& s) {
   p.accel_time_ms = o.quantity("accel_time", Dimension::time, p.accel_time_ms, non_negative());
   p.speed_mm_per_ms = o.quantity("speed", Dimension::speed, p.speed_mm_per_ms, positive());
   p.travel_mm = o.quantity("travel", Dimension::length, p.travel_mm, positive());
+  p.hold_ms = o.quantity("hold", Dimension::time, p.hold_ms, non_negative());
   s.direction = o.vector3("direction", s.direction);
   NEEDLE_REQUIRE(s.direction.allFinite() && s.direction.norm() > 0, fmt::format("{} must be a non-zero vector", o.where("direction")));
   try {
@@ -216,10 +217,12 @@ json scene_to_json(const Scene& s) {
                    {"damping_ratio", t.contact.damping_ratio}, {"needle_stiffness_scale", t.contact.needle_stiffness_scale},
                    {"cuts_bonds", t.contact.cuts_bonds}}}};
   const CannulaOptions& c = s.cannula;
+  json motion = {{"accel_time_ms", s.motion.accel_time_ms}, {"speed_m_per_s", s.motion.speed_mm_per_ms}, {"travel_mm", s.motion.travel_mm},
+                 {"direction", vector_json(s.direction)}};
+  if (s.motion.hold_ms > 0) motion["hold_ms"] = s.motion.hold_ms;  // written only when used: stored scenes stay as they were
   return {
       {"needle", needle},
-      {"motion", {{"accel_time_ms", s.motion.accel_time_ms}, {"speed_m_per_s", s.motion.speed_mm_per_ms},
-                  {"travel_mm", s.motion.travel_mm}, {"direction", vector_json(s.direction)}}},
+      {"motion", motion},
       {"cannula", {{"enabled", c.enabled}, {"outer_diameter_mm", c.outer_diameter_mm}, {"wall_mm", c.wall_mm},
                    {"front_x_mm", c.front_x_mm}, {"length_mm", c.length_mm}, {"friction", c.friction},
                    {"penalty_scale", c.penalty_scale}}},

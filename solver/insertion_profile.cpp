@@ -14,22 +14,25 @@ void InsertionProfile::validate(const std::string& where) const {
   NEEDLE_REQUIRE(std::isfinite(speed_mm_per_ms) && speed_mm_per_ms > 0,
                  fmt::format("{}: the insertion speed must be positive (got {} m/s)", where, speed_mm_per_ms));
   NEEDLE_REQUIRE(std::isfinite(travel_mm) && travel_mm > 0, fmt::format("{}: travel_mm must be positive (got {})", where, travel_mm));
+  NEEDLE_REQUIRE(std::isfinite(hold_ms) && hold_ms >= 0, fmt::format("{}: hold_ms must be zero or positive (got {})", where, hold_ms));
   NEEDLE_REQUIRE(travel_mm >= 0.5 * speed_mm_per_ms * accel_time_ms,
                  fmt::format("{}: travel {} mm ends before the speed is reached ({} mm of ramp)", where, travel_mm,
                              0.5 * speed_mm_per_ms * accel_time_ms));
 }
 
-double InsertionProfile::end_time_ms() const {
+double InsertionProfile::travel_end_time_ms() const {
   return accel_time_ms + (travel_mm - 0.5 * speed_mm_per_ms * accel_time_ms) / speed_mm_per_ms;
 }
 
+double InsertionProfile::end_time_ms() const { return travel_end_time_ms() + hold_ms; }
+
 double InsertionProfile::velocity_mm_per_ms(double t) const {
-  if (t <= 0 || t > end_time_ms()) return 0.0;  // still moving at the end of the travel
+  if (t <= 0 || t > travel_end_time_ms()) return 0.0;  // still moving at the end of the travel
   return t < accel_time_ms ? speed_mm_per_ms * t / accel_time_ms : speed_mm_per_ms;
 }
 
 double InsertionProfile::displacement_mm(double t) const {
-  t = std::clamp(t, 0.0, end_time_ms());
+  t = std::clamp(t, 0.0, travel_end_time_ms());
   if (t < accel_time_ms) return 0.5 * speed_mm_per_ms * t * t / accel_time_ms;
   return 0.5 * speed_mm_per_ms * accel_time_ms + speed_mm_per_ms * (t - accel_time_ms);
 }

@@ -247,7 +247,8 @@ TEST_CASE("needle run: no needle, two needles or a bad number exit 2 with one li
                                  "run --preset SB --tissue-friction -0.1 --out " + (dir / "a").string(),
                                  "run --preset SB --tissue-law neo_hookean --out " + (dir / "a").string(),
                                  "run --preset SB --speed-m-per-s 0 --out " + (dir / "a").string(),
-                                 "run --preset SB --speed-m-per-s 100 --out " + (dir / "a").string()}) {
+                                 "run --preset SB --speed-m-per-s 100 --out " + (dir / "a").string(),
+                                 "run --preset SB --hold-ms -1 --out " + (dir / "a").string()}) {
     const auto r = run(args, true);
     INFO(args << " -> " << r.out);
     CHECK(r.exit_code == 2);
@@ -322,4 +323,34 @@ TEST_CASE("needle run --speed-m-per-s: the scene says so and the drive ends when
     INFO("v " << v << " m/s: history ends at " << end_ms << " ms, profile " << expected_ms << " ms");
     CHECK(end_ms == Approx(expected_ms).epsilon(1e-6));
   }
+}
+
+TEST_CASE("needle run --hold-ms: the base stops at the travel's end, the drive does no more work, the run ends after the hold",
+          "[apps][lspg][gmsh]") {
+  // The rod's scene at 8 m/s reaches 0.8 mm at t = 0.02 + (0.8 - 0.08) / 8 = 0.11 ms; a 0.06 ms hold follows. While the base is
+  // still its reaction does no work, so the drive's work must not change over the hold, while the tissue still moves.
+  const fs::path dir = fresh_folder("hold");
+  const auto r = run_rod_into_block(dir, R"({"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4})", 0.8, 0, "--hold-ms 0.06");
+  INFO(r.out);
+  REQUIRE(r.exit_code == 0);
+  std::ifstream scene_file(dir / "run" / "scene.json"), summary_file(dir / "run" / "summary.json");
+  const nlohmann::json scene = nlohmann::json::parse(scene_file), summary = nlohmann::json::parse(summary_file);
+  CHECK(scene["motion"]["hold_ms"].get<double>() == 0.06);
+  CHECK(summary["status"] == "finished");
+  const needle::CsvTable history = needle::read_csv_table((dir / "run" / "history.csv").string());
+  const auto& time = history.column("time_ms");
+  const auto& insertion = history.column("insertion_mm");
+  const auto& drive_work = history.column("drive_work_mJ");
+  const double travel_end_ms = 0.11;
+  CHECK(time.back() == Approx(travel_end_ms + 0.06).epsilon(1e-6));
+  std::size_t at_stop = 0;
+  while (at_stop < time.size() && time[at_stop] < travel_end_ms) ++at_stop;
+  REQUIRE(at_stop + 2 < time.size());  // rows within the hold
+  CHECK(time[at_stop] < travel_end_ms + 0.02 + 1e-9);  // the first row after the stop (rows every 0.02 ms)
+  CHECK(drive_work[at_stop] > 0);
+  for (std::size_t i = at_stop; i < time.size(); ++i) {
+    CHECK(insertion[i] == Approx(0.8).epsilon(1e-9));
+    CHECK(drive_work[i] == Approx(drive_work[at_stop]).epsilon(1e-9));
+  }
+  CHECK(summary["energy_balance_error"].get<double>() < 0.02);
 }

@@ -50,6 +50,22 @@ TEST_CASE("The paper's drive profile: 0 to 8 m/s in 0.75 ms, then 8 m/s to 30 mm
   bad = InsertionProfile{};
   bad.speed_mm_per_ms = -8;
   CHECK_THROWS_AS(bad.validate(), InputError);
+  bad = InsertionProfile{};
+  bad.hold_ms = -0.1;
+  CHECK_THROWS_AS(bad.validate(), InputError);
+}
+
+TEST_CASE("A hold after the travel: the base stops at the travel's end and stays there", "[solver][needle]") {
+  InsertionProfile p;
+  p.hold_ms = 0.5;
+  p.validate();
+  const double travel_end = 0.75 + 27.0 / 8.0;
+  CHECK(p.travel_end_time_ms() == Approx(travel_end));
+  CHECK(p.end_time_ms() == Approx(travel_end + 0.5));
+  CHECK(p.velocity_mm_per_ms(travel_end) == Approx(8.0));
+  CHECK(p.velocity_mm_per_ms(travel_end + 1e-9) == 0.0);
+  CHECK(p.displacement_mm(travel_end + 0.25) == Approx(30.0));
+  CHECK(p.displacement_mm(p.end_time_ms()) == Approx(30.0));
 }
 
 TEST_CASE("Mirroring a half mesh gives an exactly symmetric, conforming full mesh", "[mesher][needle]") {
