@@ -318,13 +318,17 @@ void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
     return !std::isnan(v);
   };
   const bool travel_given = given(o.travel_mm, "--travel-mm"), speed_given = given(o.speed_m_per_s, "--speed-m-per-s");
+  auto given_or_zero = [](double v, const char* flag) {
+    NEEDLE_REQUIRE(std::isnan(v) || (std::isfinite(v) && v >= 0), fmt::format("{} must be a number >= 0 (got {})", flag, v));
+    return !std::isnan(v);
+  };
+  const bool decel_given = given_or_zero(o.decel_time_ms, "--decel-time-ms"), hold_given = given_or_zero(o.hold_ms, "--hold-ms");
   if (travel_given) scene.motion.travel_mm = o.travel_mm;
   if (speed_given) scene.motion.speed_mm_per_ms = o.speed_m_per_s;  // m/s = mm/ms
-  if (travel_given || speed_given) scene.motion.validate(travel_given ? "--travel-mm" : "--speed-m-per-s");
-  if (!std::isnan(o.hold_ms)) {
-    NEEDLE_REQUIRE(std::isfinite(o.hold_ms) && o.hold_ms >= 0, fmt::format("--hold-ms must be a number >= 0 (got {})", o.hold_ms));
-    scene.motion.hold_ms = o.hold_ms;
-  }
+  if (decel_given) scene.motion.decel_time_ms = o.decel_time_ms;
+  if (hold_given) scene.motion.hold_ms = o.hold_ms;
+  if (travel_given || speed_given || decel_given || hold_given)
+    scene.motion.validate(travel_given ? "--travel-mm" : speed_given ? "--speed-m-per-s" : decel_given ? "--decel-time-ms" : "--hold-ms");
   if (given(o.spacing_mm, "--spacing-mm")) scene.tissue.spacing_mm = o.spacing_mm;
   if (o.path_refinement != 0) {
     NEEDLE_REQUIRE(o.path_refinement >= 1 && o.path_refinement <= 8,
@@ -364,9 +368,13 @@ void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
   c->add_option("--speed-m-per-s", o.speed_m_per_s,
                 "Insertion speed after the 0.75 ms ramp (the paper's model 8 m/s; its experiment fired at about 4 m/s; "
                 "scene key motion.speed_m_per_s)");
+  c->add_option("--decel-time-ms", o.decel_time_ms,
+                "Decelerate the base to rest over this time, ending at the travel (default 0: the paper's model ends at full speed; "
+                "scene key motion.decel_time_ms)");
   c->add_option("--hold-ms", o.hold_ms,
                 "Hold the needle's base still this long after the travel, so that delta is read at rest as the experiment reads it "
-                "(default 0: at the end of the travel, as the paper's model; scene key motion.hold_ms)");
+                "(default 0: at the end of the travel, as the paper's model; without --decel-time-ms the stop is instantaneous "
+                "and the needle rings; scene key motion.hold_ms)");
 }
 
 std::string scene_override_arguments(const SceneOverrides& o) {
@@ -380,6 +388,7 @@ std::string scene_override_arguments(const SceneOverrides& o) {
   if (!std::isnan(o.tissue_friction)) line += fmt::format(" --tissue-friction {}", o.tissue_friction);
   if (!o.tissue_law.empty()) line += fmt::format(" --tissue-law {}", o.tissue_law);
   if (!std::isnan(o.speed_m_per_s)) line += fmt::format(" --speed-m-per-s {}", o.speed_m_per_s);
+  if (!std::isnan(o.decel_time_ms)) line += fmt::format(" --decel-time-ms {}", o.decel_time_ms);
   if (!std::isnan(o.hold_ms)) line += fmt::format(" --hold-ms {}", o.hold_ms);
   return line;
 }

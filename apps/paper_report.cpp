@@ -83,6 +83,8 @@ NeedleRun read_run(const std::string& out_dir, const std::string& name) {
     const double speed_m_per_s = scene.contains("motion") ? scene["motion"].value("speed_m_per_s", 8.0) : 8.0;
     if (speed_m_per_s != InsertionProfile{}.speed_mm_per_ms)
       r.tissue_resolution += fmt::format("; the needle is driven at {:g} m/s (the paper's model: 8)", speed_m_per_s);
+    const double decel_ms = scene.contains("motion") ? scene["motion"].value("decel_time_ms", 0.0) : 0.0;
+    if (decel_ms > 0) r.tissue_resolution += fmt::format("; the base decelerates to rest over {:g} ms", decel_ms);
     const double hold_ms = scene.contains("motion") ? scene["motion"].value("hold_ms", 0.0) : 0.0;
     if (hold_ms > 0) r.tissue_resolution += fmt::format("; delta is read after the base is held still for {:g} ms", hold_ms);
   }

@@ -63,6 +63,7 @@ void read_motion(SceneObject o, Scene& s) {
   p.accel_time_ms = o.quantity("accel_time", Dimension::time, p.accel_time_ms, non_negative());
   p.speed_mm_per_ms = o.quantity("speed", Dimension::speed, p.speed_mm_per_ms, positive());
   p.travel_mm = o.quantity("travel", Dimension::length, p.travel_mm, positive());
+  p.decel_time_ms = o.quantity("decel_time", Dimension::time, p.decel_time_ms, non_negative());
   p.hold_ms = o.quantity("hold", Dimension::time, p.hold_ms, non_negative());
   s.direction = o.vector3("direction", s.direction);
   NEEDLE_REQUIRE(s.direction.allFinite() && s.direction.norm() > 0, fmt::format("{} must be a non-zero vector", o.where("direction")));
@@ -219,7 +220,9 @@ json scene_to_json(const Scene& s) {
   const CannulaOptions& c = s.cannula;
   json motion = {{"accel_time_ms", s.motion.accel_time_ms}, {"speed_m_per_s", s.motion.speed_mm_per_ms}, {"travel_mm", s.motion.travel_mm},
                  {"direction", vector_json(s.direction)}};
-  if (s.motion.hold_ms > 0) motion["hold_ms"] = s.motion.hold_ms;  // written only when used: stored scenes stay as they were
+  // Written only when used: stored scenes (the paper's model, neither) stay as they were.
+  if (s.motion.decel_time_ms > 0) motion["decel_time_ms"] = s.motion.decel_time_ms;
+  if (s.motion.hold_ms > 0) motion["hold_ms"] = s.motion.hold_ms;
   return {
       {"needle", needle},
       {"motion", motion},

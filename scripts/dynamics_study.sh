@@ -3,12 +3,14 @@
 # model drives at 8 m/s and reads delta at full speed; its experiment fired the needle at about 4 m/s and
 # read the tip at rest. The gel's shear wave speed, sqrt(G / rho), is 3-4 m/s at the calibrated E, so the
 # tissue's inertia may matter. Runs SB and AMB 10 mm into data/scenes/spacing_study_10mm.json (0.2 mm
-# particles near the path) under three drives and prints delta and AMB / SB for each (docs/paper.md):
-#   8ms         the paper's model: 8 m/s, delta at the travel's end
-#   4ms         the experiment's speed: 4 m/s (--speed-m-per-s 4)
-#   8ms_hold1   8 m/s, then the base held still 1 ms and delta read at rest (--hold-ms 1)
+# particles near the path) under these drives and prints delta and AMB / SB for each (docs/paper.md):
+#   8ms              the paper's model: 8 m/s, delta at the travel's end
+#   4ms              the experiment's speed: 4 m/s (--speed-m-per-s 4)
+#   8ms_hold1        8 m/s, stopped at once, held still 1 ms (--hold-ms 1): the undamped steel rings axially
+#   8ms_decel_hold1  8 m/s, ramped to rest over 0.2 ms, held still 1 ms (--decel-time-ms 0.2 --hold-ms 1)
 #
-#   scripts/dynamics_study.sh [OUT] [LAW] [E_MPa]     default: out/dynamics_study stiffening_elastic 0.03
+#   scripts/dynamics_study.sh [OUT] [LAW] [E_MPa] [DRIVE...]
+#       default: out/dynamics_study stiffening_elastic 0.03, every drive
 #
 # A finished run (OUT/<needle>_<drive>/summary.json) is kept, so an interrupted study resumes. Each run
 # takes 6-20 min on one core.
@@ -17,10 +19,16 @@ cd "$(dirname "$0")/.."
 out="${1:-out/dynamics_study}"
 law="${2:-stiffening_elastic}"
 E="${3:-0.03}"
+shift 3 || shift $#
 [ -x build/apps/needle ] || bash scripts/build.sh
 mkdir -p "$out"
 
-drives=("8ms|" "4ms|--speed-m-per-s 4" "8ms_hold1|--hold-ms 1")
+declare -A drive_flags=([8ms]="" [4ms]="--speed-m-per-s 4" [8ms_hold1]="--hold-ms 1" [8ms_decel_hold1]="--decel-time-ms 0.2 --hold-ms 1")
+drives=("$@")
+[ "${#drives[@]}" -gt 0 ] || drives=(8ms 4ms 8ms_hold1 8ms_decel_hold1)
+for drive in "${drives[@]}"; do
+  [ -n "${drive_flags[$drive]+set}" ] || { echo "dynamics_study: unknown drive '$drive' (8ms, 4ms, 8ms_hold1, 8ms_decel_hold1)" >&2; exit 2; }
+done
 
 number() {  # number KEY FILE: the first numeric value of "KEY": in a JSON file
   grep -o "\"$1\": *[-0-9.eE+]*" "$2" | head -1 | sed 's/.*: *//'
@@ -29,9 +37,8 @@ number() {  # number KEY FILE: the first numeric value of "KEY": in a JSON file
 csv="$out/dynamics_study.csv"
 echo "needle,drive,tissue_law,tissue_E_MPa,deflection_mm,deflection_at_travel_end_mm,coupling_steps,max_energy_balance_error,runtime_s,status" > "$csv.partial"
 for needle in SB AMB; do
-  for entry in "${drives[@]}"; do
-    drive="${entry%%|*}"
-    flags="${entry#*|}"
+  for drive in "${drives[@]}"; do
+    flags="${drive_flags[$drive]}"
     run="$out/${needle}_${drive}"
     if [ ! -f "$run/summary.json" ]; then
       # shellcheck disable=SC2086  # flags are words

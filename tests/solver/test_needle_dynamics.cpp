@@ -68,6 +68,34 @@ TEST_CASE("A hold after the travel: the base stops at the travel's end and stays
   CHECK(p.displacement_mm(p.end_time_ms()) == Approx(30.0));
 }
 
+TEST_CASE("A deceleration ramp: the base comes to rest exactly at the travel, its velocity continuous", "[solver][needle]") {
+  InsertionProfile p;
+  p.decel_time_ms = 0.25;  // 1 mm of the 30 at 8 m/s
+  p.hold_ms = 0.1;
+  p.validate();
+  const double cruise_end = 0.75 + (30.0 - 3.0 - 1.0) / 8.0;
+  CHECK(p.cruise_end_time_ms() == Approx(cruise_end));
+  CHECK(p.travel_end_time_ms() == Approx(cruise_end + 0.25));
+  CHECK(p.end_time_ms() == Approx(cruise_end + 0.35));
+  CHECK(p.velocity_mm_per_ms(cruise_end) == Approx(8.0));
+  CHECK(p.velocity_mm_per_ms(cruise_end + 0.125) == Approx(4.0));
+  CHECK(p.velocity_mm_per_ms(cruise_end + 0.25 - 1e-9) == Approx(0.0).margin(1e-6));
+  CHECK(p.displacement_mm(cruise_end) == Approx(29.0));
+  CHECK(p.displacement_mm(cruise_end + 0.125) == Approx(29.0 + 0.75));  // 8 * 0.125 - 8 * 0.125^2 / (2 * 0.25)
+  CHECK(p.displacement_mm(p.end_time_ms()) == Approx(30.0));
+  // The displacement is the integral of the velocity through all three phases and the hold.
+  const int n = 200000;
+  double integral = 0;
+  for (int i = 0; i < n; ++i) integral += p.velocity_mm_per_ms((i + 0.5) * p.end_time_ms() / n) * p.end_time_ms() / n;
+  CHECK(integral == Approx(30.0).epsilon(1e-6));
+  InsertionProfile bad = p;
+  bad.travel_mm = 3.5;  // shorter than the 3 + 1 mm of the two ramps
+  CHECK_THROWS_AS(bad.validate(), InputError);
+  bad = p;
+  bad.decel_time_ms = -1;
+  CHECK_THROWS_AS(bad.validate(), InputError);
+}
+
 TEST_CASE("Mirroring a half mesh gives an exactly symmetric, conforming full mesh", "[mesher][needle]") {
   const TetMesh half = rod_mesh(5.0, 0.5, true, 1);
   const TetMesh full = mirrored_union(half, 2);
