@@ -29,11 +29,11 @@ done
 # on 2 cores. A run the solver stops is reported as such in the report, not an error of the main job.
 # The report sets three other models beside it, from their stored reports in docs/paper_results/: the
 # same particles without the needle's cut, the paper's 0.4 mm particles with it, and the tissue law
-# that stiffens as the paper's measured curve (docs/paper.md).
+# that stiffens as the paper's measured curve, calibrated on SB (docs/paper.md).
 ./build/apps/needle paper --calibration data/paper/calibration_sb.json --out out/paper --label "cut, 0.2 mm near the path" \
   --compare "no cut, 0.2 mm near the path=docs/paper_results/no_cut/results.json" \
   --compare "cut, 0.4 mm (the paper's spacing)=docs/paper_results/particles_0.4mm/results.json" \
-  --compare "stiffening law, E 0.03 (not calibrated)=docs/paper_results/stiffening/results.json"
+  --compare "stiffening law, calibrated on SB=docs/paper_results/stiffening_calibrated/results.json"
 echo "results in out/: <preset>.json (report), <preset>.stl, <preset>_half.glb, <preset>.png,"
 echo "  <preset>_half_t10.msh/.vtu + <preset>_mesh.json (T10 mesh and its report), tissue_particles.vtp/.json,"
 echo "  material_test.csv/.png/.json (the tissue card in uniaxial tension), stiffness_<preset>.json (tip compliance"
