@@ -58,14 +58,14 @@ mv "$csv.partial" "$csv"
 
 awk -F, 'NR > 1 { d[$1, $2] = $5; e[$1, $2] = $6; s[$1, $2] = $10; if (!($2 in seen)) { seen[$2] = 1; order[++m] = $2 } }
 END {
-  printf "%-10s %10s %10s %9s   %s\n", "drive", "SB", "AMB", "AMB/SB", "(delta in mm at the end; at the travel'"'"'s end in brackets where a hold follows)"
+  printf "%-16s %10s %10s %9s   %s\n", "drive", "SB", "AMB", "AMB/SB", "(delta in mm at the end; at the travel'"'"'s end in brackets where a hold follows)"
   for (i = 1; i <= m; ++i) {
     k = order[i]
-    printf "%-10s %+10.3f %+10.3f %9.2f", k, d["SB", k], d["AMB", k], d["SB", k] != 0 ? d["AMB", k] / d["SB", k] : 0
+    printf "%-16s %+10.3f %+10.3f %9.2f", k, d["SB", k], d["AMB", k], d["SB", k] != 0 ? d["AMB", k] / d["SB", k] : 0
     if (k ~ /hold/) printf "   (%+.3f, %+.3f)", e["SB", k], e["AMB", k]
     if (s["SB", k] != "finished" || s["AMB", k] != "finished") printf "   a run stopped: see its summary.json"
     printf "\n"
   }
-  printf "%-10s %10s %10s %9s\n", "experiment", "-1.14", "+0.24", "-0.21 (at 30 mm)"
+  printf "%-16s %10s %10s %9s\n", "experiment", "-1.14", "+0.24", "-0.21 (at 30 mm)"
 }' "$csv"
 echo "table: $csv; runs in $out/<needle>_<drive>"
