@@ -313,15 +313,16 @@ bool run_insertion_unless_done(const Scene& scene, const RunOptions& options) {
 }
 
 void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
+  // NaN: not given; otherwise checked, with an InputError naming the flag.
   auto given = [](double v, const char* flag) {
     NEEDLE_REQUIRE(std::isnan(v) || (std::isfinite(v) && v > 0), fmt::format("{} must be a positive number (got {})", flag, v));
     return !std::isnan(v);
   };
-  const bool travel_given = given(o.travel_mm, "--travel-mm"), speed_given = given(o.speed_m_per_s, "--speed-m-per-s");
   auto given_or_zero = [](double v, const char* flag) {
     NEEDLE_REQUIRE(std::isnan(v) || (std::isfinite(v) && v >= 0), fmt::format("{} must be a number >= 0 (got {})", flag, v));
     return !std::isnan(v);
   };
+  const bool travel_given = given(o.travel_mm, "--travel-mm"), speed_given = given(o.speed_m_per_s, "--speed-m-per-s");
   const bool decel_given = given_or_zero(o.decel_time_ms, "--decel-time-ms"), hold_given = given_or_zero(o.hold_ms, "--hold-ms");
   if (travel_given) scene.motion.travel_mm = o.travel_mm;
   if (speed_given) scene.motion.speed_mm_per_ms = o.speed_m_per_s;  // m/s = mm/ms
@@ -345,11 +346,8 @@ void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
     scene.tissue.material.law = tissue_law_from_name(o.tissue_law);
     scene.tissue.material.validate();
   }
-  if (!std::isnan(o.tissue_friction)) {
-    NEEDLE_REQUIRE(std::isfinite(o.tissue_friction) && o.tissue_friction >= 0,
-                   fmt::format("--tissue-friction must be a number >= 0 (got {})", o.tissue_friction));
+  if (given_or_zero(o.tissue_friction, "--tissue-friction"))
     scene.tissue.friction = scene.tissue.contact.friction = o.tissue_friction;  // as the scene key tissue.friction sets both
-  }
 }
 
 void add_scene_override_options(CLI::App* c, SceneOverrides& o) {

@@ -32,7 +32,7 @@ struct NeedleRun : NeedleOutcome {
   std::string folder, reason;
   double runtime_s = kNaN, floor_contact_fraction = kNaN, mean_gap_mm = kNaN, max_energy_error = kNaN, max_penetration_mm = kNaN;
   long bonds_broken = 0, bonds_cut_by_needle = 0, particles_inside = 0, steps = 0, particles = 0;
-  std::string tissue_resolution;  // from the run's scene.json: the particle spacing and the needle's cut
+  std::string model_description;  // from the run's scene.json: the particles, the needle's cut, the law and the drive where not the paper's
   bool needle_cuts = false;       // the scene's tissue.contact.cuts_bonds
   CsvTable history, facets;
 };
@@ -68,25 +68,28 @@ NeedleRun read_run(const std::string& out_dir, const std::string& name) {
       const json& t = scene["tissue"];
       const double h = t.value("spacing_mm", kNaN);
       const int refinement = t.value("path_refinement", 1);
-      r.tissue_resolution = refinement > 1 ? fmt::format("{:g} mm particles, {:g} mm within {:g} mm of the path", h, h / refinement,
+      r.model_description = refinement > 1 ? fmt::format("{:g} mm particles, {:g} mm within {:g} mm of the path", h, h / refinement,
                                                          t.value("path_half_width_mm", kNaN))
                                            : fmt::format("{:g} mm particles", h);
       r.needle_cuts = t.contains("contact") && t["contact"].value("cuts_bonds", false);
-      r.tissue_resolution += fmt::format(" ({} particles); the needle {} the bonds its body passes through", r.particles,
+      r.model_description += fmt::format(" ({} particles); the needle {} the bonds its body passes through", r.particles,
                                          r.needle_cuts ? "cuts" : "does not cut");
       // The paper's card is the default and goes unnamed; another law is said.
       if (t.contains("material") &&
           tissue_law_from_name(t["material"].value("law", tissue_law_name(TissueLaw::mat018))) == TissueLaw::stiffening_elastic)
-        r.tissue_resolution += "; the tissue stiffens as measured (stiffening_elastic: 3 G eps + k eps^n)";
+        r.model_description += "; the tissue stiffens as measured (stiffening_elastic: 3 G eps + k eps^n)";
     }
-    // The paper's model drives at 8 m/s and goes unnamed; another speed (its experiment's 4 m/s) is said.
-    const double speed_m_per_s = scene.contains("motion") ? scene["motion"].value("speed_m_per_s", 8.0) : 8.0;
-    if (speed_m_per_s != InsertionProfile{}.speed_mm_per_ms)
-      r.tissue_resolution += fmt::format("; the needle is driven at {:g} m/s (the paper's model: 8)", speed_m_per_s);
-    const double decel_ms = scene.contains("motion") ? scene["motion"].value("decel_time_ms", 0.0) : 0.0;
-    if (decel_ms > 0) r.tissue_resolution += fmt::format("; the base decelerates to rest over {:g} ms", decel_ms);
-    const double hold_ms = scene.contains("motion") ? scene["motion"].value("hold_ms", 0.0) : 0.0;
-    if (hold_ms > 0) r.tissue_resolution += fmt::format("; delta is read after the base is held still for {:g} ms", hold_ms);
+    // The paper's drive (8 m/s, read at full speed) goes unnamed; another speed, a stop or a hold is said.
+    const InsertionProfile paper_drive;
+    const json motion = scene.value("motion", json::object());
+    const double speed_m_per_s = motion.value("speed_m_per_s", paper_drive.speed_mm_per_ms);
+    const double decel_ms = motion.value("decel_time_ms", paper_drive.decel_time_ms);
+    const double hold_ms = motion.value("hold_ms", paper_drive.hold_ms);
+    if (speed_m_per_s != paper_drive.speed_mm_per_ms)
+      r.model_description += fmt::format("; the needle is driven at {:g} m/s (the paper's model: {:g})", speed_m_per_s,
+                                         paper_drive.speed_mm_per_ms);
+    if (decel_ms != paper_drive.decel_time_ms) r.model_description += fmt::format("; the base decelerates to rest over {:g} ms", decel_ms);
+    if (hold_ms != paper_drive.hold_ms) r.model_description += fmt::format("; delta is read after the base is held still for {:g} ms", hold_ms);
   }
   r.history = read_csv_table((fs::path(r.folder) / "history.csv").string());
   r.facets = read_csv_table((fs::path(r.folder) / "facet_forces.csv").string());
@@ -237,7 +240,7 @@ void write_paper_report(const PaperReportInput& in) {
   const std::vector<NeedleOutcome> outcomes(runs.begin(), runs.end());
   const std::vector<PaperTarget> targets = evaluate_paper_targets(outcomes, in.reference);
   const fs::path dir(in.out_dir);
-  const std::string tissue = runs.empty() ? std::string() : runs.front().tissue_resolution;
+  const std::string tissue = runs.empty() ? std::string() : runs.front().model_description;
   std::vector<ModelResults> models;
   if (!in.compare.empty()) {
     ModelResults self;

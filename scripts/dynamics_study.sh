@@ -30,9 +30,8 @@ for drive in "${drives[@]}"; do
   [ -n "${drive_flags[$drive]+set}" ] || { echo "dynamics_study: unknown drive '$drive' (8ms, 4ms, 8ms_hold1, 8ms_decel_hold1)" >&2; exit 2; }
 done
 
-number() {  # number KEY FILE: the first numeric value of "KEY": in a JSON file
-  grep -o "\"$1\": *[-0-9.eE+]*" "$2" | head -1 | sed 's/.*: *//'
-}
+# shellcheck source=scripts/summary_fields.sh
+source scripts/summary_fields.sh
 
 csv="$out/dynamics_study.csv"
 echo "needle,drive,tissue_law,tissue_E_MPa,deflection_mm,deflection_at_travel_end_mm,coupling_steps,max_energy_balance_error,runtime_s,status" > "$csv.partial"
@@ -46,12 +45,12 @@ for needle in SB AMB; do
         --tissue-law "$law" --tissue-E-MPa "$E" $flags --out "$run" --overwrite || true  # a stopped run is reported with its status
     fi
     [ -f "$run/summary.json" ] || { echo "dynamics_study: no summary in $run" >&2; exit 1; }
-    status=$(grep -o '"status": *"[a-z]*"' "$run/summary.json" | head -1 | sed 's/.*: *"//; s/"//')
+    status=$(summary_status "$run/summary.json")
     # delta when the travel ended: the last history row whose insertion is still short of the travel, or the first at it.
     at_travel_end=$(awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) col[$i] = i; next }
       { if (!done) { d = $col["deflection_mm"]; if ($col["insertion_mm"] >= 10 - 1e-9) done = 1 } }
       END { printf "%.6g", d }' "$run/history.csv")
-    echo "$needle,$drive,$law,$E,$(number deflection_mm "$run/summary.json"),$at_travel_end,$(number steps "$run/summary.json"),$(number max_energy_balance_error "$run/summary.json"),$(number runtime_s "$run/summary.json"),$status" >> "$csv.partial"
+    echo "$needle,$drive,$law,$E,$(summary_number deflection_mm "$run/summary.json"),$at_travel_end,$(summary_number steps "$run/summary.json"),$(summary_number max_energy_balance_error "$run/summary.json"),$(summary_number runtime_s "$run/summary.json"),$status" >> "$csv.partial"
   done
 done
 mv "$csv.partial" "$csv"

@@ -18,9 +18,8 @@ needles=("$@")
 [ -x build/apps/needle ] || bash scripts/build.sh
 mkdir -p "$out"
 
-number() {  # number KEY FILE: the first numeric value of "KEY": in a JSON file
-  grep -o "\"$1\": *[-0-9.eE+]*" "$2" | head -1 | sed 's/.*: *//'
-}
+# shellcheck source=scripts/summary_fields.sh
+source scripts/summary_fields.sh
 
 csv="$out/spacing_study.csv"
 echo "needle,path_refinement,near_path_spacing_mm,particles,deflection_mm,runtime_s,status" > "$csv.partial"
@@ -32,8 +31,8 @@ for needle in "${needles[@]}"; do
         --out "$run" --overwrite || true  # a stopped run is reported with its status
     fi
     [ -f "$run/summary.json" ] || { echo "spacing_study: no summary in $run" >&2; exit 1; }
-    status=$(grep -o '"status": *"[a-z]*"' "$run/summary.json" | head -1 | sed 's/.*: *"//; s/"//')
-    echo "$needle,$k,$(awk -v k="$k" 'BEGIN { printf "%g", 0.4 / k }'),$(number particles "$run/summary.json"),$(number deflection_mm "$run/summary.json"),$(number runtime_s "$run/summary.json"),$status" >> "$csv.partial"
+    status=$(summary_status "$run/summary.json")
+    echo "$needle,$k,$(awk -v k="$k" 'BEGIN { printf "%g", 0.4 / k }'),$(summary_number particles "$run/summary.json"),$(summary_number deflection_mm "$run/summary.json"),$(summary_number runtime_s "$run/summary.json"),$status" >> "$csv.partial"
   done
 done
 mv "$csv.partial" "$csv"
