@@ -1,7 +1,9 @@
 #include "apps/insertion_run.h"
 
+#include <algorithm>
 #include <chrono>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <fstream>
 
 #include "apps/run_folder.h"
@@ -348,6 +350,12 @@ void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
   }
   if (given_or_zero(o.tissue_friction, "--tissue-friction"))
     scene.tissue.friction = scene.tissue.contact.friction = o.tissue_friction;  // as the scene key tissue.friction sets both
+  if (!o.tissue_size_mm.empty()) {
+    const std::vector<double>& v = o.tissue_size_mm;
+    NEEDLE_REQUIRE(v.size() == 3 && std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x) && x > 0; }),
+                   fmt::format("--tissue-size-mm must be three positive lengths x,y,z (got {})", fmt::join(v, ",")));
+    scene.tissue.size_mm = {v[0], v[1], v[2]};
+  }
 }
 
 void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
@@ -373,6 +381,11 @@ void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
                 "Hold the needle's base still this long after the travel, so that delta is read at rest as the experiment reads it "
                 "(default 0: at the end of the travel, as the paper's model; without --decel-time-ms the stop is instantaneous "
                 "and the needle rings; scene key motion.hold_ms)");
+  c->add_option("--tissue-size-mm", o.tissue_size_mm,
+                "The tissue block's length x, height y (centred on the path) and half width z, e.g. 40,16,6 (the paper's "
+                "40,8,2; the experiment's phantom: 100 long, 30 high, 80 wide; the faces y = +-Y/2 and z = Z are fixed; scene key tissue.size_mm)")
+      ->expected(3)
+      ->delimiter(',');
 }
 
 std::string scene_override_arguments(const SceneOverrides& o) {
@@ -388,6 +401,7 @@ std::string scene_override_arguments(const SceneOverrides& o) {
   if (!std::isnan(o.speed_m_per_s)) line += fmt::format(" --speed-m-per-s {}", o.speed_m_per_s);
   if (!std::isnan(o.decel_time_ms)) line += fmt::format(" --decel-time-ms {}", o.decel_time_ms);
   if (!std::isnan(o.hold_ms)) line += fmt::format(" --hold-ms {}", o.hold_ms);
+  if (!o.tissue_size_mm.empty()) line += fmt::format(" --tissue-size-mm {}", fmt::join(o.tissue_size_mm, ","));
   return line;
 }
 

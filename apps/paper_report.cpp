@@ -10,6 +10,7 @@
 
 #include "apps/csv_table.h"
 #include "apps/json_file.h"
+#include "apps/scene.h"
 #include "geometry/cad_solid.h"
 #include "geometry/grinding_recipe.h"
 #include "geometry/input_error.h"
@@ -78,6 +79,14 @@ NeedleRun read_run(const std::string& out_dir, const std::string& name) {
       if (t.contains("material") &&
           tissue_law_from_name(t["material"].value("law", tissue_law_name(TissueLaw::mat018))) == TissueLaw::stiffening_elastic)
         r.model_description += "; the tissue stiffens as measured (stiffening_elastic: 3 G eps + k eps^n)";
+      // The paper's 40 x 8 x 2 mm half block goes unnamed; another block is said.
+      const TissueScene paper_block;
+      if (t.contains("size_mm") && t["size_mm"].is_array() && t["size_mm"].size() == 3) {
+        const Eigen::Vector3d size{t["size_mm"][0].get<double>(), t["size_mm"][1].get<double>(), t["size_mm"][2].get<double>()};
+        if (size != paper_block.size_mm)
+          r.model_description += fmt::format("; a {:g} x {:g} x {:g} mm half block (the paper's: {:g} x {:g} x {:g})", size.x(), size.y(),
+                                             size.z(), paper_block.size_mm.x(), paper_block.size_mm.y(), paper_block.size_mm.z());
+      }
     }
     // The paper's drive (8 m/s, read at full speed) goes unnamed; another speed, a stop or a hold is said.
     const InsertionProfile paper_drive;
