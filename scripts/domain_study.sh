@@ -28,8 +28,8 @@ for block in "${blocks[@]}"; do
   [ -n "${block_flags[$block]+set}" ] || { echo "domain_study: unknown block '$block' (paper, y16z6, y24z10)" >&2; exit 2; }
 done
 
-# shellcheck source=scripts/summary_fields.sh
-source scripts/summary_fields.sh
+# shellcheck source=scripts/study_helpers.sh
+source scripts/study_helpers.sh
 
 csv="$out/domain_study.csv"
 echo "needle,block,size_mm,particles,deflection_mm,coupling_steps,max_energy_balance_error,runtime_s,status" > "$csv.partial"
@@ -37,13 +37,10 @@ for needle in SB AMB; do
   for block in "${blocks[@]}"; do
     flags="${block_flags[$block]}"
     run="$out/${needle}_${block}"
-    if [ ! -f "$run/summary.json" ]; then
-      # shellcheck disable=SC2086  # flags are words
-      ./build/apps/needle run --scene data/scenes/spacing_study_10mm.json --preset "$needle" --path-refinement 2 \
-        $flags --out "$run" --overwrite || true  # a stopped run is reported with its status
-    fi
-    [ -f "$run/summary.json" ] || { echo "domain_study: no summary in $run" >&2; exit 1; }
-    size=$(grep -o '"size_mm": *\[[^]]*\]' "$run/scene.json" | head -1 | sed 's/.*\[//; s/\]//; s/[[:space:]]//g; s/,/ x /g')
+    # shellcheck disable=SC2086  # flags are words
+    study_run domain_study "$run" "$needle" --path-refinement 2 $flags
+    # the tissue's size_mm is the scene's only array-valued size_mm; scene.json spreads it over lines
+    size=$(tr -d '[:space:]' < "$run/scene.json" | grep -o '"size_mm":\[[^]]*\]' | head -1 | sed 's/.*\[//; s/\]//; s/,/ x /g')
     echo "$needle,$block,$size,$(summary_number particles "$run/summary.json"),$(summary_number deflection_mm "$run/summary.json"),$(summary_number steps "$run/summary.json"),$(summary_number max_energy_balance_error "$run/summary.json"),$(summary_number runtime_s "$run/summary.json"),$(summary_status "$run/summary.json")" >> "$csv.partial"
   done
 done

@@ -30,8 +30,8 @@ for drive in "${drives[@]}"; do
   [ -n "${drive_flags[$drive]+set}" ] || { echo "dynamics_study: unknown drive '$drive' (8ms, 4ms, 8ms_hold1, 8ms_decel_hold1)" >&2; exit 2; }
 done
 
-# shellcheck source=scripts/summary_fields.sh
-source scripts/summary_fields.sh
+# shellcheck source=scripts/study_helpers.sh
+source scripts/study_helpers.sh
 
 csv="$out/dynamics_study.csv"
 echo "needle,drive,tissue_law,tissue_E_MPa,deflection_mm,deflection_at_travel_end_mm,coupling_steps,max_energy_balance_error,runtime_s,status" > "$csv.partial"
@@ -39,12 +39,8 @@ for needle in SB AMB; do
   for drive in "${drives[@]}"; do
     flags="${drive_flags[$drive]}"
     run="$out/${needle}_${drive}"
-    if [ ! -f "$run/summary.json" ]; then
-      # shellcheck disable=SC2086  # flags are words
-      ./build/apps/needle run --scene data/scenes/spacing_study_10mm.json --preset "$needle" --path-refinement 2 \
-        --tissue-law "$law" --tissue-E-MPa "$E" $flags --out "$run" --overwrite || true  # a stopped run is reported with its status
-    fi
-    [ -f "$run/summary.json" ] || { echo "dynamics_study: no summary in $run" >&2; exit 1; }
+    # shellcheck disable=SC2086  # flags are words
+    study_run dynamics_study "$run" "$needle" --path-refinement 2 --tissue-law "$law" --tissue-E-MPa "$E" $flags
     status=$(summary_status "$run/summary.json")
     # delta when the travel ended: the last history row whose insertion is still short of the travel, or the first at it.
     at_travel_end=$(awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) col[$i] = i; next }

@@ -18,19 +18,15 @@ needles=("$@")
 [ -x build/apps/needle ] || bash scripts/build.sh
 mkdir -p "$out"
 
-# shellcheck source=scripts/summary_fields.sh
-source scripts/summary_fields.sh
+# shellcheck source=scripts/study_helpers.sh
+source scripts/study_helpers.sh
 
 csv="$out/spacing_study.csv"
 echo "needle,path_refinement,near_path_spacing_mm,particles,deflection_mm,runtime_s,status" > "$csv.partial"
 for needle in "${needles[@]}"; do
   for k in 1 2 4; do
     run="$out/${needle}_r$k"
-    if [ ! -f "$run/summary.json" ]; then
-      ./build/apps/needle run --scene data/scenes/spacing_study_10mm.json --preset "$needle" --path-refinement "$k" \
-        --out "$run" --overwrite || true  # a stopped run is reported with its status
-    fi
-    [ -f "$run/summary.json" ] || { echo "spacing_study: no summary in $run" >&2; exit 1; }
+    study_run spacing_study "$run" "$needle" --path-refinement "$k"
     status=$(summary_status "$run/summary.json")
     echo "$needle,$k,$(awk -v k="$k" 'BEGIN { printf "%g", 0.4 / k }'),$(summary_number particles "$run/summary.json"),$(summary_number deflection_mm "$run/summary.json"),$(summary_number runtime_s "$run/summary.json"),$status" >> "$csv.partial"
   done

@@ -39,6 +39,23 @@ needle_test::Result run_rod_into_block(const fs::path& dir, const std::string& t
   return run("run --scene " + (dir / "scene.json").string() + " --out " + (dir / "run").string() + " --quiet " + flags, true);
 }
 
+// The files of a finished run folder: the effective scene, the summary and the history.
+struct RunFiles {
+  nlohmann::json scene, summary;
+  needle::CsvTable history;
+};
+
+// The plain rod pushed 0.8 mm into the small block (2 x 2.4 x 1.2 mm, 0.4 mm particles) with these flags; the run must succeed.
+RunFiles run_rod_into_small_block(const std::string& name, const std::string& flags) {
+  const fs::path dir = fresh_folder(name);
+  const auto r = run_rod_into_block(dir, R"({"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4})", 0.8, 0, flags);
+  INFO(r.out);
+  REQUIRE(r.exit_code == 0);
+  std::ifstream scene_file(dir / "run" / "scene.json"), summary_file(dir / "run" / "summary.json");
+  return {nlohmann::json::parse(scene_file), nlohmann::json::parse(summary_file),
+          needle::read_csv_table((dir / "run" / "history.csv").string())};
+}
+
 std::string message_of(const std::string& text) {
   try {
     needle::parse_scene(text, "scene.json");
@@ -262,12 +279,8 @@ TEST_CASE("needle run --no-needle-cut: the tissue separates by bond failure alon
   // The same short insertion with and without the needle's cut: the flag turns the cut off and says
   // so in the effective scene; with the cut on, the rod's passage cuts bonds.
   auto run_variant = [](const std::string& name, const std::string& flags) {
-    const fs::path dir = fresh_folder(name);
-    const auto r = run_rod_into_block(dir, R"({"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4})", 0.8, 0, flags);
-    INFO(r.out);
-    REQUIRE(r.exit_code == 0);
-    std::ifstream summary_file(dir / "run" / "summary.json"), scene_file(dir / "run" / "scene.json");
-    return std::pair{nlohmann::json::parse(summary_file), nlohmann::json::parse(scene_file)};
+    const RunFiles run = run_rod_into_small_block(name, flags);
+    return std::pair{run.summary, run.scene};
   };
   const auto [cut_summary, cut_scene] = run_variant("insertion_cut", "");
   const auto [plain_summary, plain_scene] = run_variant("insertion_no_cut", "--no-needle-cut");
@@ -283,14 +296,8 @@ TEST_CASE("needle run --tissue-law stiffening_elastic: the scene says so and the
   // small-strain modulus, so the tissue's reaction on the rod must be larger. The default law is not
   // written into the effective scene (stored scenes and runs stay as they were).
   auto run_variant = [](const std::string& name, const std::string& flags) {
-    const fs::path dir = fresh_folder(name);
-    const auto r = run_rod_into_block(dir, R"({"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4})", 0.8, 0, "--tissue-E-MPa 0.03 " + flags);
-    INFO(r.out);
-    REQUIRE(r.exit_code == 0);
-    std::ifstream scene_file(dir / "run" / "scene.json");
-    const nlohmann::json scene = nlohmann::json::parse(scene_file);
-    const needle::CsvTable history = needle::read_csv_table((dir / "run" / "history.csv").string());
-    return std::pair{scene, std::abs(history.column("contact_force_x_N").back())};
+    const RunFiles run = run_rod_into_small_block(name, "--tissue-E-MPa 0.03 " + flags);
+    return std::pair{run.scene, std::abs(run.history.column("contact_force_x_N").back())};
   };
   const auto [card_scene, card_drag_N] = run_variant("law_card", "");
   const auto [stiff_scene, stiff_drag_N] = run_variant("law_stiffening", "--tissue-law stiffening_elastic");
@@ -305,18 +312,11 @@ TEST_CASE("needle run --speed-m-per-s: the scene says so and the drive ends when
   // The rod's scene ramps 0 -> v in 0.02 ms, then runs at v to 0.8 mm: it ends at
   // t = 0.02 + (0.8 - v 0.02 / 2) / v ms. Halving the speed must nearly double the run's simulated time.
   auto end_of_run = [](const std::string& name, double speed_m_per_s) {
-    const fs::path dir = fresh_folder(name);
-    const auto r = run_rod_into_block(dir, R"({"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4})", 0.8, 0,
-                                      fmt::format("--speed-m-per-s {}", speed_m_per_s));
-    INFO(r.out);
-    REQUIRE(r.exit_code == 0);
-    std::ifstream scene_file(dir / "run" / "scene.json"), summary_file(dir / "run" / "summary.json");
-    const nlohmann::json scene = nlohmann::json::parse(scene_file), summary = nlohmann::json::parse(summary_file);
-    CHECK(scene["motion"]["speed_m_per_s"].get<double>() == speed_m_per_s);
-    CHECK(summary["status"] == "finished");
-    CHECK(summary["insertion_mm"].get<double>() == Approx(0.8).epsilon(1e-6));
-    const needle::CsvTable history = needle::read_csv_table((dir / "run" / "history.csv").string());
-    return history.column("time_ms").back();
+    const RunFiles run = run_rod_into_small_block(name, fmt::format("--speed-m-per-s {}", speed_m_per_s));
+    CHECK(run.scene["motion"]["speed_m_per_s"].get<double>() == speed_m_per_s);
+    CHECK(run.summary["status"] == "finished");
+    CHECK(run.summary["insertion_mm"].get<double>() == Approx(0.8).epsilon(1e-6));
+    return run.history.column("time_ms").back();
   };
   for (const double v : {8.0, 4.0}) {
     const double expected_ms = 0.02 + (0.8 - 0.5 * v * 0.02) / v;
@@ -330,15 +330,11 @@ TEST_CASE("needle run --hold-ms: the base stops at the travel's end, the drive d
           "[apps][lspg][gmsh]") {
   // The rod's scene at 8 m/s reaches 0.8 mm at t = 0.02 + (0.8 - 0.08) / 8 = 0.11 ms; a 0.06 ms hold follows. While the base is
   // still its reaction does no work, so the drive's work must not change over the hold, while the tissue still moves.
-  const fs::path dir = fresh_folder("hold");
-  const auto r = run_rod_into_block(dir, R"({"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4})", 0.8, 0, "--hold-ms 0.06");
-  INFO(r.out);
-  REQUIRE(r.exit_code == 0);
-  std::ifstream scene_file(dir / "run" / "scene.json"), summary_file(dir / "run" / "summary.json");
-  const nlohmann::json scene = nlohmann::json::parse(scene_file), summary = nlohmann::json::parse(summary_file);
-  CHECK(scene["motion"]["hold_ms"].get<double>() == 0.06);
+  const RunFiles run = run_rod_into_small_block("hold", "--hold-ms 0.06");
+  const nlohmann::json& summary = run.summary;
+  const needle::CsvTable& history = run.history;
+  CHECK(run.scene["motion"]["hold_ms"].get<double>() == 0.06);
   CHECK(summary["status"] == "finished");
-  const needle::CsvTable history = needle::read_csv_table((dir / "run" / "history.csv").string());
   const auto& time = history.column("time_ms");
   const auto& insertion = history.column("insertion_mm");
   const auto& drive_work = history.column("drive_work_mJ");
@@ -365,17 +361,11 @@ TEST_CASE("needle run --tissue-size-mm: the lattice fills the given block, and f
     double internal_mJ, drag_N;
   };
   auto push_into = [](const std::string& name, const std::string& size_flag) {
-    const fs::path dir = fresh_folder(name);
-    const auto r = run_rod_into_block(dir, R"({"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4})", 0.8, 0, size_flag);
-    INFO(r.out);
-    REQUIRE(r.exit_code == 0);
-    std::ifstream scene_file(dir / "run" / "scene.json"), summary_file(dir / "run" / "summary.json");
-    const nlohmann::json scene = nlohmann::json::parse(scene_file), summary = nlohmann::json::parse(summary_file);
-    CHECK(summary["status"] == "finished");
-    const needle::CsvTable history = needle::read_csv_table((dir / "run" / "history.csv").string());
-    return std::pair{scene["tissue"]["size_mm"],
-                     Block{summary["particles"].get<long>(), history.column("tissue_internal_mJ").back(),
-                           std::abs(history.column("contact_force_x_N").back())}};
+    const RunFiles run = run_rod_into_small_block(name, size_flag);
+    CHECK(run.summary["status"] == "finished");
+    return std::pair{run.scene["tissue"]["size_mm"],
+                     Block{run.summary["particles"].get<long>(), run.history.column("tissue_internal_mJ").back(),
+                           std::abs(run.history.column("contact_force_x_N").back())}};
   };
   const auto [narrow_size, narrow] = push_into("size_narrow", "");
   const auto [wide_size, wide] = push_into("size_wide", "--tissue-size-mm 2,4,2.4");
@@ -400,11 +390,7 @@ TEST_CASE("needle run --decel-time-ms: a ramped stop leaves the needle far less 
   // The steel rod, stopped at once from 8 m/s, keeps its kinetic energy (0.6 mJ for this 6 mm half rod) ringing axially
   // with no damping. Ramped to rest over 0.02 ms, four axial periods (4 L / c = 4.9 us), it keeps a small fraction.
   auto needle_kinetic_in_hold = [](const std::string& name, const std::string& flags, double stop_ms) {
-    const fs::path dir = fresh_folder(name);
-    const auto r = run_rod_into_block(dir, R"({"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4})", 0.8, 0, flags);
-    INFO(r.out);
-    REQUIRE(r.exit_code == 0);
-    const needle::CsvTable history = needle::read_csv_table((dir / "run" / "history.csv").string());
+    const needle::CsvTable history = run_rod_into_small_block(name, flags).history;
     const auto time = history.column("time_ms"), kinetic = history.column("needle_kinetic_mJ"), insertion = history.column("insertion_mm");
     CHECK(time.back() == Approx(stop_ms + 0.06).epsilon(1e-6));
     CHECK(insertion.back() == Approx(0.8).epsilon(1e-9));
