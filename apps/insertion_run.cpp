@@ -270,6 +270,7 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
       {"bonds_broken", run.bonds_broken()},
       {"bonds_cut_by_needle", run.bonds_cut_by_needle()},
       {"bond_cut_s", run.bond_cut_s()},
+      {"slit", {{"particles_opened", run.particles_opened_by_slit()}, {"max_opening_mm", SymmetrySlit::max_opening_mm(run.tissue().particles())}}},
       {"groove",
        {{"groove_fill", groove.groove_fill},
         {"floor_contact_fraction", groove.floor_contact_fraction},
@@ -356,6 +357,11 @@ void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
                    fmt::format("--tissue-size-mm must be three positive lengths x,y,z (got {})", fmt::join(v, ",")));
     scene.tissue.size_mm = {v[0], v[1], v[2]};
   }
+  if (given_or_zero(o.slit_half_height_mm, "--slit-half-height-mm")) {
+    NEEDLE_REQUIRE(o.slit_half_height_mm == 0 || scene.needle.half_model,
+                   "--slit-half-height-mm needs a half model: the slit opens the symmetry plane");
+    scene.tissue.contact.slit.half_height_mm = o.slit_half_height_mm;
+  }
 }
 
 void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
@@ -386,6 +392,10 @@ void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
                 "40,8,2; the experiment's phantom: 100 long, 30 high, 80 wide; the faces y = +-Y/2 and z = Z are fixed; scene key tissue.size_mm)")
       ->expected(3)
       ->delimiter(',');
+  c->add_option("--slit-half-height-mm", o.slit_half_height_mm,
+                "The tissue also opens in the symmetry plane behind the tip point, within this distance of the rod's axis, so the "
+                "needle can push it aside instead of only up and down (0.5: as tall as the rod; default 0: no slit; scene key "
+                "tissue.contact.slit_half_height_mm; half models only)");
 }
 
 std::string scene_override_arguments(const SceneOverrides& o) {
@@ -402,6 +412,7 @@ std::string scene_override_arguments(const SceneOverrides& o) {
   if (!std::isnan(o.decel_time_ms)) line += fmt::format(" --decel-time-ms {}", o.decel_time_ms);
   if (!std::isnan(o.hold_ms)) line += fmt::format(" --hold-ms {}", o.hold_ms);
   if (!o.tissue_size_mm.empty()) line += fmt::format(" --tissue-size-mm {}", fmt::join(o.tissue_size_mm, ","));
+  if (!std::isnan(o.slit_half_height_mm)) line += fmt::format(" --slit-half-height-mm {}", o.slit_half_height_mm);
   return line;
 }
 

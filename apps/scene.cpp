@@ -132,6 +132,8 @@ void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc) {
     t.contact.damping_ratio = c.number("damping_ratio", t.contact.damping_ratio, within(0.0, 1.0));
     t.contact.needle_stiffness_scale = c.number("needle_stiffness_scale", t.contact.needle_stiffness_scale, within(1e-6, 0.5));
     t.contact.cuts_bonds = c.boolean("cuts_bonds", t.contact.cuts_bonds);
+    t.contact.slit.half_height_mm = c.quantity("slit_half_height", Dimension::length, t.contact.slit.half_height_mm, non_negative());
+    t.contact.slit.lead_mm = c.quantity("slit_lead", Dimension::length, t.contact.slit.lead_mm, non_negative());
     c.finish();
   }
   o.finish();
@@ -199,7 +201,7 @@ json scene_to_json(const Scene& s) {
                         {"density_g_per_cm3", n.material.density_g_per_mm3 * 1e3}};
   needle["rigid"] = n.rigid;
   const TissueScene& t = s.tissue;
-  const json tissue = {
+  json tissue = {
       {"enabled", t.enabled}, {"size_mm", vector_json(t.size_mm)}, {"entry_x_mm", t.entry_x_mm}, {"spacing_mm", t.spacing_mm},
       {"path_refinement", t.path_refinement}, {"path_half_width_mm", t.path_half_width_mm},
       {"dilation", t.dilation}, {"friction", t.friction}, {"material", material_to_json(t.material)},
@@ -217,6 +219,11 @@ json scene_to_json(const Scene& s) {
       {"contact", {{"stiffness_factor", t.contact.stiffness_factor}, {"skin_mm", t.contact.skin_mm}, {"voxel_mm", t.contact.voxel_mm},
                    {"damping_ratio", t.contact.damping_ratio}, {"needle_stiffness_scale", t.contact.needle_stiffness_scale},
                    {"cuts_bonds", t.contact.cuts_bonds}}}};
+  // Written only when used: stored scenes (no slit) stay as they were.
+  if (t.contact.slit.enabled()) {
+    tissue["contact"]["slit_half_height_mm"] = t.contact.slit.half_height_mm;
+    tissue["contact"]["slit_lead_mm"] = t.contact.slit.lead_mm;
+  }
   const CannulaOptions& c = s.cannula;
   json motion = {{"accel_time_ms", s.motion.accel_time_ms}, {"speed_m_per_s", s.motion.speed_mm_per_ms}, {"travel_mm", s.motion.travel_mm},
                  {"direction", vector_json(s.direction)}};

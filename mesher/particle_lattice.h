@@ -18,8 +18,10 @@ namespace needle {
 
 enum class FaceCondition { free, fixed, symmetry };
 
-// Particle flags (bits): a particle on two faces carries both faces' flags.
-enum ParticleFlag : std::uint8_t { kParticleFixed = 1, kParticleSymmetry = 2, kParticleFreeSurface = 4 };
+// Particle flags (bits): a particle on two faces carries both faces' flags. kParticleOpenSymmetry is set
+// during a run (solver/symmetry_slit.h): a symmetry particle a crack in the plane has released keeps
+// z >= 0 only, its mirror image being its contact partner.
+enum ParticleFlag : std::uint8_t { kParticleFixed = 1, kParticleSymmetry = 2, kParticleFreeSurface = 4, kParticleOpenSymmetry = 8 };
 
 struct TissueBox {
   Eigen::Vector3d min_mm{0.0, -4.0, 0.0};  // the paper's 40 x 8 x 2 mm half block, needle path y = z = 0

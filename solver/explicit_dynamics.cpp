@@ -9,6 +9,9 @@
 #include "solver/solver_error.h"
 
 namespace needle {
+namespace {
+constexpr double kOnPlaneMm = 1e-9;  // an open symmetry particle this close to z = 0 rests on the plane
+}  // namespace
 
 double EnergyBalance::relative_error() const {
   const double residual = kinetic_mJ - initial_kinetic_mJ - model_work_mJ - body_work_mJ - external_work_mJ - constraint_work_mJ;
@@ -46,16 +49,36 @@ TissueDynamics::TissueDynamics(SpgTissue& tissue, std::vector<VelocityConstraint
   acceleration_.resize(static_cast<size_t>(p.size()));
   for (std::int64_t i = 0; i < p.size(); ++i)
     acceleration_[static_cast<size_t>(i)] = p.force_N[static_cast<size_t>(i)] / p.mass_g[static_cast<size_t>(i)] + body_acceleration_;
-  apply_constraints(tissue_.particles().velocity_mm_per_ms, 0.0);
+  apply_constraints(tissue_.particles().velocity_mm_per_ms, 0.0, 0.0);
   energy_.initial_kinetic_mJ = energy_.kinetic_mJ = kinetic_energy_mJ();
 }
 
-void TissueDynamics::apply_constraints(std::vector<Vec3d>& v, double time_ms) {
+void TissueDynamics::apply_constraints(std::vector<Vec3d>& v, double time_ms, double drift_dt_ms) {
   const TissueParticles& p = tissue_.particles();
   for (std::int64_t i = 0; i < p.size(); ++i) {
-    const std::uint8_t f = p.flags[static_cast<size_t>(i)];
-    if (f & kParticleFixed) v[static_cast<size_t>(i)].setZero();
-    else if (f & kParticleSymmetry) v[static_cast<size_t>(i)].z() = 0.0;
+    const size_t s = static_cast<size_t>(i);
+    const std::uint8_t f = p.flags[s];
+    if (f & kParticleFixed) v[s].setZero();
+    else if (f & kParticleOpenSymmetry) {
+      // z >= 0. On the plane the particle is held as a symmetry particle is (v_z >= 0 instead of = 0);
+      // above it, a drift that would cross the plane ends on it: an impact, whose impulses J = m dv do the
+      // work J (v_before + v_after) / 2 where the reactions' sum in step() books J v_half (the drift's).
+      const double z = p.position_mm[s].z();
+      if (drift_dt_ms > 0) {
+        const double landing = -z / drift_dt_ms;
+        if (z > kOnPlaneMm && v[s].z() < landing) {
+          const double jump = landing - v[s].z();
+          impact_work_correction_mJ_ -= 0.5 * p.mass_g[s] * jump * jump;
+          landed_.push_back({static_cast<std::int32_t>(i), landing});
+        }
+        v[s].z() = std::max(v[s].z(), landing);
+      } else if (z <= kOnPlaneMm && v[s].z() < 0) {
+        const double before = v[s].z();
+        v[s].z() = 0.0;
+        for (const Landing& l : landed_)
+          if (l.particle == i) impact_work_correction_mJ_ += -0.5 * p.mass_g[s] * before * before + p.mass_g[s] * before * l.v_half_z;
+      }
+    } else if (f & kParticleSymmetry) v[s].z() = 0.0;
   }
   for (const VelocityConstraint& c : constraints_) {
     const double value = c.velocity_mm_per_ms(time_ms);
@@ -105,12 +128,12 @@ StepReport TissueDynamics::step(double max_dt_ms) {
   std::vector<Vec3d>& constrained_velocity_before = constrained_velocity_before_;
   std::vector<Vec3d>& constrained_velocity_half = constrained_velocity_half_;
   for (size_t k = 0; k < constrained_.size(); ++k) constrained_velocity_before[k] = p.velocity_mm_per_ms[static_cast<size_t>(constrained_[k])];
-  auto kick = [&](double half_dt, double at_time) {
+  auto kick = [&](double half_dt, double at_time, double drift_dt) {
     std::vector<Vec3d>& v = p.velocity_mm_per_ms;
     for (std::int64_t i = 0; i < n; ++i) v[static_cast<size_t>(i)] += half_dt * acceleration_[static_cast<size_t>(i)];
-    apply_constraints(v, at_time);
+    apply_constraints(v, at_time, drift_dt);
   };
-  kick(0.5 * dt, time_ms_ + 0.5 * dt);
+  kick(0.5 * dt, time_ms_ + 0.5 * dt, dt);
   for (size_t k = 0; k < constrained_.size(); ++k) constrained_velocity_half[k] = p.velocity_mm_per_ms[static_cast<size_t>(constrained_[k])];
   std::vector<Vec3d>& old_force = old_force_;
   std::vector<Vec3d>& displacement = displacement_;
@@ -150,7 +173,7 @@ StepReport TissueDynamics::step(double max_dt_ms) {
   energy_.model_work_mJ += model_work;
   energy_.body_work_mJ += body_work;
   energy_.external_work_mJ += external_work;
-  kick(0.5 * dt, time_ms_);
+  kick(0.5 * dt, time_ms_, 0.0);
   // Reactions on constrained components: R = m dv/dt - f over the step, working through the displacement.
   double constraint_work = 0;
   for (size_t k = 0; k < constrained_.size(); ++k) {
@@ -162,7 +185,9 @@ StepReport TissueDynamics::step(double max_dt_ms) {
                          0.5 * (old_force[s][axis] + p.force_N[s][axis] + external_force_[s][axis]) * displacement[s][axis];
     }
   }
-  energy_.constraint_work_mJ += constraint_work;
+  energy_.constraint_work_mJ += constraint_work + impact_work_correction_mJ_;
+  impact_work_correction_mJ_ = 0;
+  landed_.clear();
   energy_.kinetic_mJ = kinetic_energy_mJ();
   if (!std::isfinite(energy_.kinetic_mJ)) throw SolverError(fmt::format("kinetic energy is not finite at t = {:.6g} ms", time_ms_));
   tissue_.end_of_step();

@@ -3,7 +3,8 @@
 // steps for the energy balance) of the SPG tissue with boundary conditions and body loads:
 //   v(n+1/2) = v(n) + dt/2 a(n);  constraints;  x(n+1) = x(n) + dt v(n+1/2);
 //   forces at x(n+1);  v(n+1) = v(n+1/2) + dt/2 a(n+1);  constraints.
-// Fixed particles (ParticleFlag) have v = 0, symmetry particles v_z = 0; velocity constraints prescribe
+// Fixed particles (ParticleFlag) have v = 0, symmetry particles v_z = 0 (opened ones z >= 0: a step's
+// drift stops on the plane, symmetry_slit.h); velocity constraints prescribe
 // one component on a set of particles. Energy balance: kinetic - kinetic(0) = work of the model's forces
 // + work of body loads + work of the reactions (on constrained components: m dv/dt - f, times the
 // displacement); its relative error is the drift of the integrator.
@@ -66,7 +67,9 @@ class TissueDynamics {
   Eigen::Vector3d constraint_internal_force_N(size_t constraint) const;
 
  private:
-  void apply_constraints(std::vector<Vec3d>& v, double time_ms);
+  // drift_dt_ms > 0 before a drift of that length: an open symmetry particle's v_z is then kept from
+  // carrying it below z = 0 (it lands on the plane); 0 after the drift.
+  void apply_constraints(std::vector<Vec3d>& v, double time_ms, double drift_dt_ms);
   double kinetic_energy_mJ() const;
 
   SpgTissue& tissue_;
@@ -76,6 +79,12 @@ class TissueDynamics {
   std::int64_t steps_ = 0;
   EnergyBalance energy_;
   std::vector<Vec3d> acceleration_;
+  double impact_work_correction_mJ_ = 0;        // this step's: open symmetry particles stopped on the plane
+  struct Landing {
+    std::int32_t particle;
+    double v_half_z;
+  };
+  std::vector<Landing> landed_;                 // this step's impacts on the plane
   std::vector<std::int32_t> constrained_;      // particles with a constrained component
   std::vector<std::uint8_t> constrained_mask_;  // per particle: bit k = component k constrained
   // Step scratch, kept to avoid allocating per step.

@@ -43,7 +43,8 @@ LspgInsertion::LspgInsertion(NeedleDynamics& needle, SpgTissue& tissue, const Co
       options_(coupling),
       tissue_dynamics_(tissue, {}, coupling.tissue_body_acceleration_mm_per_ms2),
       contact_(surface, tissue.particles(), tissue.material(), contact),
-      bond_cut_(surface) {
+      bond_cut_(surface),
+      slit_(needle.needle().mesh().X, contact.slit) {
   options_.validate();
   NEEDLE_REQUIRE(needle.steps() == 0 && needle.time_ms() == 0, "the coupled run must start with a needle at t = 0");
   NEEDLE_REQUIRE(surface.reference_positions().rows() == needle.positions_mm().rows(),
@@ -119,6 +120,7 @@ void LspgInsertion::step(double end_time_ms) {
     tissue_.cut_bonds(bond_cut_.bonds_through_needle(tissue_.bonds(), tissue_.particles().position_mm, needle_.positions_mm()));
     bond_cut_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
+  slit_.open(tissue_.particles(), needle_.positions_mm());
   ++steps_;
   last_dt_ms_ = dt;
   update_energy();

@@ -20,6 +20,7 @@ void ContactOptions::validate(const std::string& where) const {
                  fmt::format("{}: needle_stiffness_scale must be in (0, 0.5] (got {})", where, needle_stiffness_scale));
   NEEDLE_REQUIRE(std::isfinite(voxel_mm) && voxel_mm >= 1e-3 && voxel_mm <= 0.2,
                  fmt::format("{}: voxel_mm must be in [0.001, 0.2] (got {})", where, voxel_mm));
+  slit.validate(where + ".slit");
 }
 
 NeedleTissueContact::NeedleTissueContact(const ContactSurface& surface, const TissueParticles& particles,

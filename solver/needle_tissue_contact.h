@@ -41,6 +41,7 @@
 
 #include "solver/contact_surface.h"
 #include "solver/spg_tissue.h"
+#include "solver/symmetry_slit.h"
 
 namespace needle {
 
@@ -53,6 +54,7 @@ struct ContactOptions {
   double voxel_mm = 0.02;         // the needle level set's resolution
   bool cuts_bonds = true;         // the needle breaks the tissue bonds its body passes through (needle_bond_cut.h);
                                   // false: only the tissue's failure criterion separates particles
+  SymmetrySlitOptions slit;       // the tissue also opens in the symmetry plane behind the tip (symmetry_slit.h); off by default
   void validate(const std::string& where = "contact") const;  // InputError naming the bad field
 };
 

@@ -386,6 +386,30 @@ TEST_CASE("needle run --tissue-size-mm: the lattice fills the given block, and f
   CHECK(!fs::exists(dir / "run"));
 }
 
+TEST_CASE("needle run --slit-half-height-mm: the symmetry plane opens behind the tip, and its particles leave the plane",
+          "[apps][lspg][gmsh][slit]") {
+  // The same rod pushed 0.8 mm in, with and without a slit 0.9 mm either side of the rod's axis. The blunt rod pushes the
+  // plane's particles within its radius (0.5 mm) ahead of it, so behind its end (x < 0.8) lie those at y = +-0.8, x = 0 and
+  // 0.4: four. Once open they may leave the plane, pulled by the tissue beside them.
+  const RunFiles closed = run_rod_into_small_block("slit_closed", "");
+  const RunFiles open = run_rod_into_small_block("slit_open", "--slit-half-height-mm 0.9");
+  CHECK_FALSE(closed.scene["tissue"]["contact"].contains("slit_half_height_mm"));  // stored scenes stay as they were
+  CHECK(open.scene["tissue"]["contact"]["slit_half_height_mm"].get<double>() == 0.9);
+  CHECK(closed.summary["slit"]["particles_opened"].get<long>() == 0);
+  CHECK(closed.summary["slit"]["max_opening_mm"].get<double>() == 0.0);
+  CHECK(open.summary["slit"]["particles_opened"].get<long>() == 4);
+  CHECK(open.summary["slit"]["max_opening_mm"].get<double>() > 0);
+  CHECK(open.summary["status"] == "finished");
+  CHECK(open.summary["max_energy_balance_error"].get<double>() < 0.05);
+
+  const fs::path dir = fresh_folder("slit_bad");
+  const auto bad = run_rod_into_block(dir, R"({"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4})", 0.8, 0, "--slit-half-height-mm -1");
+  CHECK(bad.exit_code == 2);
+  CHECK(std::count(bad.out.begin(), bad.out.end(), '\n') == 1);
+  CHECK(bad.out.find("--slit-half-height-mm must be a number >= 0 (got -1)") != std::string::npos);
+  CHECK(!fs::exists(dir / "run"));
+}
+
 TEST_CASE("needle run --decel-time-ms: a ramped stop leaves the needle far less ringing than an instantaneous one", "[apps][lspg][gmsh]") {
   // The steel rod, stopped at once from 8 m/s, keeps its kinetic energy (0.6 mJ for this 6 mm half rod) ringing axially
   // with no damping. Ramped to rest over 0.02 ms, four axial periods (4 L / c = 4.9 us), it keeps a small fraction.

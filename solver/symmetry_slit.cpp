@@ -1,0 +1,53 @@
+#include "solver/symmetry_slit.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+
+#include "geometry/input_error.h"
+#include "mesher/particle_lattice.h"
+
+namespace needle {
+
+void SymmetrySlitOptions::validate(const std::string& where) const {
+  NEEDLE_REQUIRE(std::isfinite(half_height_mm) && half_height_mm >= 0,
+                 fmt::format("{}: half_height_mm must be zero (no slit) or positive (got {})", where, half_height_mm));
+  NEEDLE_REQUIRE(std::isfinite(lead_mm) && lead_mm >= 0, fmt::format("{}: lead_mm must be zero or positive (got {})", where, lead_mm));
+}
+
+SymmetrySlit::SymmetrySlit(const Eigen::MatrixX3d& needle_reference_mm, const SymmetrySlitOptions& options) : options_(options) {
+  options_.validate();
+  NEEDLE_REQUIRE(needle_reference_mm.rows() > 0, "slit: the needle has no nodes");
+  needle_reference_mm.col(0).maxCoeff(&tip_node_);
+  tip_reference_mm_ = needle_reference_mm.row(tip_node_).transpose();
+}
+
+std::int64_t SymmetrySlit::open(TissueParticles& particles, const Eigen::MatrixX3d& needle_x) {
+  if (!options_.enabled()) return 0;
+  const Eigen::Vector3d tip = needle_x.row(tip_node_).transpose();
+  const double front_x = tip.x() + options_.lead_mm;
+  const double axis_y = tip.y() - tip_reference_mm_.y();  // the rod's axis is y = 0 in the needle's frame
+  std::int64_t now = 0;
+  for (std::int64_t i = 0; i < particles.size(); ++i) {
+    const size_t s = static_cast<size_t>(i);
+    std::uint8_t& flag = particles.flags[s];
+    if (!(flag & kParticleSymmetry) || (flag & (kParticleOpenSymmetry | kParticleFixed))) continue;
+    const Vec3d& x = particles.position_mm[s];
+    if (x.x() <= front_x && std::abs(x.y() - axis_y) <= options_.half_height_mm) {
+      flag |= kParticleOpenSymmetry;
+      ++now;
+    }
+  }
+  opened_ += now;
+  return now;
+}
+
+double SymmetrySlit::max_opening_mm(const TissueParticles& particles) {
+  double opening = 0;
+  for (std::int64_t i = 0; i < particles.size(); ++i)
+    if (particles.flags[static_cast<size_t>(i)] & kParticleOpenSymmetry)
+      opening = std::max(opening, particles.position_mm[static_cast<size_t>(i)].z());
+  return opening;
+}
+
+}  // namespace needle
