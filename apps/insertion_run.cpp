@@ -244,6 +244,7 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
   const double deflection = u.y() - needle_run.drive_displacement_mm().y();
   const InsertionEnergy& e = run.energy();
   const GrooveFill groove = run_groove_fill(run, built, scene);
+  const SymmetrySlit::Opening slit_opening = SymmetrySlit::opening(run.tissue());
   const json summary = {
       {"status", status},
       {"reason", reason},
@@ -270,7 +271,8 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
       {"bonds_broken", run.bonds_broken()},
       {"bonds_cut_by_needle", run.bonds_cut_by_needle()},
       {"bond_cut_s", run.bond_cut_s()},
-      {"slit", {{"particles_opened", run.particles_opened_by_slit()}, {"max_opening_mm", SymmetrySlit::max_opening_mm(run.tissue().particles())}}},
+      {"slit", {{"particles_opened", run.particles_opened_by_slit()}, {"max_opening_mm", slit_opening.max_mm},
+                {"mean_opening_mm", slit_opening.mean_mm}}},
       {"groove",
        {{"groove_fill", groove.groove_fill},
         {"floor_contact_fraction", groove.floor_contact_fraction},

@@ -87,6 +87,11 @@ NeedleRun read_run(const std::string& out_dir, const std::string& name) {
           r.model_description += fmt::format("; a {:g} x {:g} x {:g} mm half block (the paper's: {:g} x {:g} x {:g})", size.x(), size.y(),
                                              size.z(), paper_block.size_mm.x(), paper_block.size_mm.y(), paper_block.size_mm.z());
       }
+      // No slit is the default and goes unnamed; a slit is said.
+      const double slit_mm = t.contains("contact") ? t["contact"].value("slit_half_height_mm", 0.0) : 0.0;
+      if (slit_mm > 0)
+        r.model_description += fmt::format("; the tissue also splits in the symmetry plane behind the tip, {:g} mm either side of the rod's axis",
+                                           slit_mm);
     }
     // The paper's drive (8 m/s, read at full speed) goes unnamed; another speed, a stop or a hold is said.
     const InsertionProfile paper_drive;

@@ -72,6 +72,8 @@ class SpgTissue {
 
   double stabilization_energy_mJ() const;
   std::int64_t valid_integration_points() const;
+  // Whether particle i is still an integration point (false once detached: a free mass point).
+  bool is_integration_point(std::int64_t i) const { return rk_.valid[static_cast<size_t>(i)] != 0; }
 
   TissueParticles& particles() { return p_; }
   const TissueParticles& particles() const { return p_; }

@@ -42,12 +42,19 @@ std::int64_t SymmetrySlit::open(TissueParticles& particles, const Eigen::MatrixX
   return now;
 }
 
-double SymmetrySlit::max_opening_mm(const TissueParticles& particles) {
-  double opening = 0;
-  for (std::int64_t i = 0; i < particles.size(); ++i)
-    if (particles.flags[static_cast<size_t>(i)] & kParticleOpenSymmetry)
-      opening = std::max(opening, particles.position_mm[static_cast<size_t>(i)].z());
-  return opening;
+SymmetrySlit::Opening SymmetrySlit::opening(const SpgTissue& tissue) {
+  const TissueParticles& p = tissue.particles();
+  Opening o;
+  std::int64_t count = 0;
+  for (std::int64_t i = 0; i < p.size(); ++i) {
+    if (!(p.flags[static_cast<size_t>(i)] & kParticleOpenSymmetry) || !tissue.is_integration_point(i)) continue;
+    const double z = p.position_mm[static_cast<size_t>(i)].z();
+    o.max_mm = std::max(o.max_mm, z);
+    o.mean_mm += z;
+    ++count;
+  }
+  if (count > 0) o.mean_mm /= static_cast<double>(count);
+  return o;
 }
 
 }  // namespace needle

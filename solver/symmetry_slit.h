@@ -38,8 +38,12 @@ class SymmetrySlit {
   // how many it opened now.
   std::int64_t open(TissueParticles& particles, const Eigen::MatrixX3d& needle_x);
   std::int64_t opened() const { return opened_; }
-  // How far the slit stands open: the largest z of an opened particle (0 if none).
-  static double max_opening_mm(const TissueParticles& particles);
+  // How far the slit stands open: the largest and the mean z of the opened particles that are still
+  // integration points (a detached crack-face particle flies free and says nothing of the slit); 0 if none.
+  struct Opening {
+    double max_mm = 0, mean_mm = 0;
+  };
+  static Opening opening(const SpgTissue& tissue);
   const SymmetrySlitOptions& options() const { return options_; }
 
  private:

@@ -399,6 +399,8 @@ TEST_CASE("needle run --slit-half-height-mm: the symmetry plane opens behind the
   CHECK(closed.summary["slit"]["max_opening_mm"].get<double>() == 0.0);
   CHECK(open.summary["slit"]["particles_opened"].get<long>() == 4);
   CHECK(open.summary["slit"]["max_opening_mm"].get<double>() > 0);
+  CHECK(open.summary["slit"]["mean_opening_mm"].get<double>() > 0);
+  CHECK(open.summary["slit"]["mean_opening_mm"].get<double>() <= open.summary["slit"]["max_opening_mm"].get<double>());
   CHECK(open.summary["status"] == "finished");
   CHECK(open.summary["max_energy_balance_error"].get<double>() < 0.05);
 

@@ -93,11 +93,21 @@ TEST_CASE("The slit opens the symmetry particles behind the tip within its half 
   }
   CHECK(open == 31);
   CHECK(open_off_plane == 0);
-  CHECK(SymmetrySlit::max_opening_mm(p) == 0.0);  // nothing has moved yet
+  CHECK(SymmetrySlit::opening(tissue).max_mm == 0.0);  // nothing has moved yet
+  CHECK(SymmetrySlit::opening(tissue).mean_mm == 0.0);
+
+  // A slit whose front runs 0.5 mm ahead of the tip opens the next column (x = 4) of the same band too.
+  SymmetrySlitOptions leading = options;
+  leading.lead_mm = 0.5;
+  SymmetrySlit ahead(needle_reference, leading);
+  CHECK(ahead.open(p, at) == 2);  // the band's 8 columns behind are open already
 
   SymmetrySlitOptions bad;
   bad.half_height_mm = -0.1;
   CHECK_THROWS_WITH(bad.validate(), Catch::Contains("half_height_mm must be zero (no slit) or positive"));
+  bad.half_height_mm = 0.5;
+  bad.lead_mm = -1;
+  CHECK_THROWS_WITH(bad.validate(), Catch::Contains("lead_mm must be zero or positive"));
 }
 
 TEST_CASE("An opened symmetry plane holds a block pressed onto it and lets go of one pulled off it", "[solver][slit][dynamics]") {
