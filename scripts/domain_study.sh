@@ -41,7 +41,7 @@ for needle in SB AMB; do
     study_run domain_study "$run" "$needle" --path-refinement 2 $flags
     # the tissue's size_mm is the scene's only array-valued size_mm; scene.json spreads it over lines
     size=$(tr -d '[:space:]' < "$run/scene.json" | grep -o '"size_mm":\[[^]]*\]' | head -1 | sed 's/.*\[//; s/\]//; s/,/ x /g')
-    echo "$needle,$block,$size,$(summary_number particles "$run/summary.json"),$(summary_number deflection_mm "$run/summary.json"),$(summary_number steps "$run/summary.json"),$(summary_number max_energy_balance_error "$run/summary.json"),$(summary_number runtime_s "$run/summary.json"),$(summary_status "$run/summary.json")" >> "$csv.partial"
+    echo "$needle,$block,$size,$(summary_number particles "$run/summary.json"),$(summary_number deflection_mm "$run/summary.json"),$(summary_run_fields "$run/summary.json")" >> "$csv.partial"
   done
 done
 mv "$csv.partial" "$csv"

@@ -41,12 +41,11 @@ for needle in SB AMB; do
     run="$out/${needle}_${drive}"
     # shellcheck disable=SC2086  # flags are words
     study_run dynamics_study "$run" "$needle" --path-refinement 2 --tissue-law "$law" --tissue-E-MPa "$E" $flags
-    status=$(summary_status "$run/summary.json")
     # delta when the travel ended: the last history row whose insertion is still short of the travel, or the first at it.
     at_travel_end=$(awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) col[$i] = i; next }
       { if (!done) { d = $col["deflection_mm"]; if ($col["insertion_mm"] >= 10 - 1e-9) done = 1 } }
       END { printf "%.6g", d }' "$run/history.csv")
-    echo "$needle,$drive,$law,$E,$(summary_number deflection_mm "$run/summary.json"),$at_travel_end,$(summary_number steps "$run/summary.json"),$(summary_number max_energy_balance_error "$run/summary.json"),$(summary_number runtime_s "$run/summary.json"),$status" >> "$csv.partial"
+    echo "$needle,$drive,$law,$E,$(summary_number deflection_mm "$run/summary.json"),$at_travel_end,$(summary_run_fields "$run/summary.json")" >> "$csv.partial"
   done
 done
 mv "$csv.partial" "$csv"

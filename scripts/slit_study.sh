@@ -37,7 +37,7 @@ for needle in SB AMB; do
     run="$out/${needle}_h$h"
     study_run slit_study "$run" "$needle" --path-refinement 2 --slit-half-height-mm "$h"
     s="$run/summary.json"
-    echo "$needle,$h,$(summary_number deflection_mm "$s"),$(summary_number particles_opened "$s"),$(summary_number mean_opening_mm "$s"),$(summary_number steps "$s"),$(summary_number max_energy_balance_error "$s"),$(summary_number runtime_s "$s"),$(summary_status "$s")" >> "$csv.partial"
+    echo "$needle,$h,$(summary_number deflection_mm "$s"),$(summary_number particles_opened "$s"),$(summary_number mean_opening_mm "$s"),$(summary_run_fields "$s")" >> "$csv.partial"
   done
 done
 mv "$csv.partial" "$csv"

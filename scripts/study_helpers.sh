@@ -20,3 +20,7 @@ summary_number() {
 summary_status() {
   grep -o '"status": *"[a-z]*"' "$1" | head -1 | sed 's/.*: *"//; s/"//'
 }
+# summary_run_fields FILE: the columns every study table ends with: coupling_steps,max_energy_balance_error,runtime_s,status
+summary_run_fields() {
+  echo "$(summary_number steps "$1"),$(summary_number max_energy_balance_error "$1"),$(summary_number runtime_s "$1"),$(summary_status "$1")"
+}

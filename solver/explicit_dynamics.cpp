@@ -55,6 +55,16 @@ TissueDynamics::TissueDynamics(SpgTissue& tissue, std::vector<VelocityConstraint
 
 void TissueDynamics::apply_constraints(std::vector<Vec3d>& v, double time_ms, double drift_dt_ms) {
   const TissueParticles& p = tissue_.particles();
+  if (drift_dt_ms == 0) {
+    // After the drift, the particles that landed this step and still move down are stopped below; that
+    // second impulse's work, corrected as the first's.
+    for (const Landing& l : landed_) {
+      const size_t s = static_cast<size_t>(l.particle);
+      const double before = v[s].z();
+      if (p.position_mm[s].z() <= kOnPlaneMm && before < 0)
+        impact_work_correction_mJ_ += -0.5 * p.mass_g[s] * before * before + p.mass_g[s] * before * l.v_half_z;
+    }
+  }
   for (std::int64_t i = 0; i < p.size(); ++i) {
     const size_t s = static_cast<size_t>(i);
     const std::uint8_t f = p.flags[s];
@@ -72,11 +82,8 @@ void TissueDynamics::apply_constraints(std::vector<Vec3d>& v, double time_ms, do
           landed_.push_back({static_cast<std::int32_t>(i), landing});
         }
         v[s].z() = std::max(v[s].z(), landing);
-      } else if (z <= kOnPlaneMm && v[s].z() < 0) {
-        const double before = v[s].z();
-        v[s].z() = 0.0;
-        for (const Landing& l : landed_)
-          if (l.particle == i) impact_work_correction_mJ_ += -0.5 * p.mass_g[s] * before * before + p.mass_g[s] * before * l.v_half_z;
+      } else if (z <= kOnPlaneMm) {
+        v[s].z() = std::max(v[s].z(), 0.0);
       }
     } else if (f & kParticleSymmetry) v[s].z() = 0.0;
   }

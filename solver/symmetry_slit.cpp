@@ -27,17 +27,23 @@ std::int64_t SymmetrySlit::open(TissueParticles& particles, const Eigen::MatrixX
   const Eigen::Vector3d tip = needle_x.row(tip_node_).transpose();
   const double front_x = tip.x() + options_.lead_mm;
   const double axis_y = tip.y() - tip_reference_mm_.y();  // the rod's axis is y = 0 in the needle's frame
-  std::int64_t now = 0;
-  for (std::int64_t i = 0; i < particles.size(); ++i) {
-    const size_t s = static_cast<size_t>(i);
-    std::uint8_t& flag = particles.flags[s];
-    if (!(flag & kParticleSymmetry) || (flag & (kParticleOpenSymmetry | kParticleFixed))) continue;
-    const Vec3d& x = particles.position_mm[s];
-    if (x.x() <= front_x && std::abs(x.y() - axis_y) <= options_.half_height_mm) {
-      flag |= kParticleOpenSymmetry;
-      ++now;
+  if (!candidates_listed_) {
+    for (std::int64_t i = 0; i < particles.size(); ++i) {
+      const std::uint8_t flag = particles.flags[static_cast<size_t>(i)];
+      if ((flag & kParticleSymmetry) && !(flag & (kParticleOpenSymmetry | kParticleFixed))) closed_.push_back(static_cast<std::int32_t>(i));
     }
+    candidates_listed_ = true;
   }
+  size_t kept = 0;  // closed_ keeps the particles still closed, in order
+  for (const std::int32_t i : closed_) {
+    const Vec3d& x = particles.position_mm[static_cast<size_t>(i)];
+    if (x.x() <= front_x && std::abs(x.y() - axis_y) <= options_.half_height_mm)
+      particles.flags[static_cast<size_t>(i)] |= kParticleOpenSymmetry;
+    else
+      closed_[kept++] = i;
+  }
+  const std::int64_t now = static_cast<std::int64_t>(closed_.size() - kept);
+  closed_.resize(kept);
   opened_ += now;
   return now;
 }

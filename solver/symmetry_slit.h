@@ -17,6 +17,7 @@
 #include <Eigen/Dense>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "solver/spg_tissue.h"
 
@@ -51,6 +52,8 @@ class SymmetrySlit {
   Eigen::Index tip_node_ = 0;
   Eigen::Vector3d tip_reference_mm_ = Eigen::Vector3d::Zero();
   std::int64_t opened_ = 0;
+  bool candidates_listed_ = false;
+  std::vector<std::int32_t> closed_;  // the symmetry particles not opened yet (listed at the first open())
 };
 
 }  // namespace needle
