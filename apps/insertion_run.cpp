@@ -364,6 +364,13 @@ void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
                    "--slit-half-height-mm needs a half model: the slit opens the symmetry plane");
     scene.tissue.contact.slit.half_height_mm = o.slit_half_height_mm;
   }
+  if (!std::isnan(o.relaxing_shear_fraction) || !std::isnan(o.relaxation_time_ms)) {
+    NEEDLE_REQUIRE(std::isnan(o.relaxation_time_ms) || !std::isnan(o.relaxing_shear_fraction) || scene.tissue.material.viscoelastic(),
+                   "--relaxation-time-ms needs --relaxing-shear-fraction (the share of the shear stress that relaxes)");
+    if (!std::isnan(o.relaxing_shear_fraction)) scene.tissue.material.relaxing_shear_fraction = o.relaxing_shear_fraction;
+    if (!std::isnan(o.relaxation_time_ms)) scene.tissue.material.relaxation_time_ms = o.relaxation_time_ms;
+    scene.tissue.material.validate();
+  }
 }
 
 void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
@@ -398,6 +405,12 @@ void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
                 "The tissue also opens in the symmetry plane behind the tip point, within this distance of the rod's axis, so the "
                 "needle can push it aside instead of only up and down (0.5: as tall as the rod; default 0: no slit; scene key "
                 "tissue.contact.slit_half_height_mm; half models only)");
+  c->add_option("--relaxing-shear-fraction", o.relaxing_shear_fraction,
+                "Viscoelastic gel: this share g of the shear stress relaxes, s(t) = s0 (1 - g (1 - exp(-t/tau))) under a held strain; "
+                "E stays the instantaneous modulus (default 0: the paper's card, no relaxation; scene key "
+                "tissue.material.relaxing_shear_fraction)");
+  c->add_option("--relaxation-time-ms", o.relaxation_time_ms,
+                "The relaxation's time constant tau (default 1 ms; scene key tissue.material.relaxation_time_ms)");
 }
 
 std::string scene_override_arguments(const SceneOverrides& o) {
@@ -415,6 +428,8 @@ std::string scene_override_arguments(const SceneOverrides& o) {
   if (!std::isnan(o.hold_ms)) line += fmt::format(" --hold-ms {}", o.hold_ms);
   if (!o.tissue_size_mm.empty()) line += fmt::format(" --tissue-size-mm {}", fmt::join(o.tissue_size_mm, ","));
   if (!std::isnan(o.slit_half_height_mm)) line += fmt::format(" --slit-half-height-mm {}", o.slit_half_height_mm);
+  if (!std::isnan(o.relaxing_shear_fraction)) line += fmt::format(" --relaxing-shear-fraction {}", o.relaxing_shear_fraction);
+  if (!std::isnan(o.relaxation_time_ms)) line += fmt::format(" --relaxation-time-ms {}", o.relaxation_time_ms);
   return line;
 }
 

@@ -19,6 +19,8 @@ TissueMaterial material_from_json(const nlohmann::json& json, const std::string&
   m.rate_C_per_ms = reader.number("rate_C_per_ms", m.rate_C_per_ms);
   m.rate_p = reader.number("rate_p", m.rate_p);
   m.max_rate_factor = reader.number("max_rate_factor", m.max_rate_factor);
+  m.relaxing_shear_fraction = reader.number("relaxing_shear_fraction", m.relaxing_shear_fraction);
+  m.relaxation_time_ms = reader.number("relaxation_time_ms", m.relaxation_time_ms);
   reader.finish();
   return m;
 }
@@ -42,6 +44,11 @@ nlohmann::json material_to_json(const TissueMaterial& m) {
   // The paper's card is the default and is not named, so scenes written before the law existed read back
   // the same (and their runs are reused).
   if (m.law != TissueLaw::mat018) json["law"] = tissue_law_name(m.law);
+  // Likewise the card has no relaxation: the keys are written only for a viscoelastic tissue.
+  if (m.viscoelastic()) {
+    json["relaxing_shear_fraction"] = m.relaxing_shear_fraction;
+    json["relaxation_time_ms"] = m.relaxation_time_ms;
+  }
   return json;
 }
 

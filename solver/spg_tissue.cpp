@@ -69,6 +69,10 @@ SpgTissue::SpgTissue(const ParticleSet& set, const TissueMaterial& material, con
   p_.stress_MPa.assign(static_cast<size_t>(n), Mat3d::Zero());
   p_.elastic_left_cauchy_green.assign(static_cast<size_t>(n), Mat3d::Identity());
   p_.plastic_strain.assign(static_cast<size_t>(n), 0.0);
+  if (material_.viscoelastic()) {
+    p_.relaxed_stress_MPa.assign(static_cast<size_t>(n), Mat3d::Zero());
+    p_.elastic_deviator_MPa.assign(static_cast<size_t>(n), Mat3d::Zero());
+  }
   p_.effective_strain.assign(static_cast<size_t>(n), 0.0);
   p_.defect_mm.assign(static_cast<size_t>(n), 0.0);
   defect_.assign(static_cast<size_t>(n), Vec3d::Zero());
@@ -125,6 +129,7 @@ ForceReport SpgTissue::compute_forces(double dt_ms) {
   enum : std::uint8_t { kCapped = 1, kFailed = 2, kDetached = 4 };
   std::vector<std::uint8_t>& status = point_status_;
   std::fill(status.begin(), status.end(), std::uint8_t{0});
+  const bool viscoelastic = material_.viscoelastic();
   // 1. Deformation gradient, stress update, V P and the smoothing defect at every integration point.
   parallel_for(n, [&](std::int64_t begin, std::int64_t end) {
     for (std::int64_t i = begin; i < end; ++i) {
@@ -134,7 +139,7 @@ ForceReport SpgTissue::compute_forces(double dt_ms) {
       if (!rk_.valid[s]) {
         piola_volume_[s].setZero();
         p_.stress_MPa[s].setZero();
-        p_.elastic_left_cauchy_green[s].setIdentity();
+        reset_material_state(s);
         p_.effective_strain[s] = p_.plastic_strain[s];
         continue;
       }
@@ -157,11 +162,21 @@ ForceReport SpgTissue::compute_forces(double dt_ms) {
         }
       }
       if (dt_ms > 0) {
-        const StressUpdate u = update_stress(material_, {p_.elastic_left_cauchy_green[s], p_.plastic_strain[s]},
-                                             F * p_.deformation_gradient[s].inverse(), dt_ms);
+        MaterialPoint point;
+        point.elastic_left_cauchy_green = p_.elastic_left_cauchy_green[s];
+        point.plastic_strain = p_.plastic_strain[s];
+        if (viscoelastic) {
+          point.relaxed_stress_MPa = p_.relaxed_stress_MPa[s];
+          point.elastic_deviator_MPa = p_.elastic_deviator_MPa[s];
+        }
+        const StressUpdate u = update_stress(material_, point, F * p_.deformation_gradient[s].inverse(), dt_ms);
         p_.stress_MPa[s] = u.cauchy_stress_MPa;
         p_.elastic_left_cauchy_green[s] = u.state.elastic_left_cauchy_green;
         p_.plastic_strain[s] = u.state.plastic_strain;
+        if (viscoelastic) {
+          p_.relaxed_stress_MPa[s] = u.state.relaxed_stress_MPa;
+          p_.elastic_deviator_MPa[s] = u.state.elastic_deviator_MPa;
+        }
         p_.effective_strain[s] = u.effective_strain;
         if (u.rate_factor_capped) status[s] = kCapped;
       }
@@ -303,8 +318,16 @@ void SpgTissue::detach(size_t s) {
   defect_[s].setZero();
   piola_volume_[s].setZero();
   p_.stress_MPa[s].setZero();
-  p_.elastic_left_cauchy_green[s].setIdentity();
+  reset_material_state(s);
   p_.effective_strain[s] = p_.plastic_strain[s];
+}
+
+void SpgTissue::reset_material_state(size_t s) {
+  p_.elastic_left_cauchy_green[s].setIdentity();
+  if (material_.viscoelastic()) {
+    p_.relaxed_stress_MPa[s].setZero();
+    p_.elastic_deviator_MPa[s].setZero();
+  }
 }
 
 double SpgTissue::stable_time_step_ms() const {
@@ -385,7 +408,7 @@ void SpgTissue::reinitialize_kernel() {
   for (std::int64_t i = 0; i < n; ++i)
     if (!rk_.valid[static_cast<size_t>(i)]) {
       p_.stress_MPa[static_cast<size_t>(i)].setZero();
-      p_.elastic_left_cauchy_green[static_cast<size_t>(i)].setIdentity();
+      reset_material_state(static_cast<size_t>(i));
     }
 }
 

@@ -38,6 +38,8 @@ struct TissueParticles {
   std::vector<Mat3d> stress_MPa;            // Cauchy
   std::vector<Mat3d> elastic_left_cauchy_green;  // b_e of the material (see tissue_material.h)
   std::vector<double> plastic_strain;
+  std::vector<Mat3d> relaxed_stress_MPa;    // the Maxwell branch's q (empty unless the material is viscoelastic)
+  std::vector<Mat3d> elastic_deviator_MPa;  // s_e of the last update (empty unless viscoelastic)
   std::vector<double> effective_strain;   // eps_p + equivalent elastic log strain (StressUpdate)
   std::vector<double> defect_mm;          // |g_i|, the smoothing defect (zero-energy-mode indicator)
   std::int64_t size() const { return static_cast<std::int64_t>(position_mm.size()); }
@@ -96,6 +98,9 @@ class SpgTissue {
   // Particle s stops being an integration point: its row, smoothing defect and stress are cleared; it
   // moves on as a free mass point.
   void detach(size_t s);
+  // An unloaded material at s: b_e = I and, if viscoelastic, no Maxwell stress (the particle stopped being
+  // an integration point).
+  void reset_material_state(size_t s);
   void refresh_reference_matrix();
 
   TissueParticles p_;

@@ -45,6 +45,10 @@ void TissueMaterial::validate() const {
   NEEDLE_REQUIRE(finite_positive(rate_p), fmt::format("rate law p must be positive (got {})", rate_p));
   NEEDLE_REQUIRE(std::isfinite(max_rate_factor) && max_rate_factor >= 1.0,
                  fmt::format("max_rate_factor must be >= 1 (got {})", max_rate_factor));
+  NEEDLE_REQUIRE(std::isfinite(relaxing_shear_fraction) && relaxing_shear_fraction >= 0 && relaxing_shear_fraction < 1,
+                 fmt::format("tissue relaxing_shear_fraction must lie in [0, 1) (got {}); 1 would leave no relaxed modulus",
+                             relaxing_shear_fraction));
+  NEEDLE_REQUIRE(finite_positive(relaxation_time_ms), fmt::format("tissue relaxation_time_ms must be positive (got {})", relaxation_time_ms));
   if (law == TissueLaw::stiffening_elastic) return;  // no yield strain to check
   const double eps_yp = yield_strain();
   NEEDLE_REQUIRE(std::isfinite(eps_yp) && eps_yp < 100.0,
@@ -87,6 +91,44 @@ double TissueMaterial::yield_stress_MPa(double plastic_strain, double factor) co
 double TissueMaterial::hardening_slope_MPa(double plastic_strain, double factor) const {
   return factor * k_MPa * n * std::pow(yield_strain() + plastic_strain, n - 1.0);
 }
+
+namespace {
+
+// The rotation of f = R U by the Newton iteration R <- (R + R^-T) / 2 (quadratic; f is near a rotation
+// in one increment). Falls back to the last iterate if f is singular enough to stop it.
+Eigen::Matrix3d polar_rotation(const Eigen::Matrix3d& f) {
+  Eigen::Matrix3d R = f;
+  for (int it = 0; it < 30; ++it) {
+    const double det = R.determinant();
+    if (!(std::abs(det) > 1e-12)) break;
+    const Eigen::Matrix3d next = 0.5 * (R + R.inverse().transpose());
+    const double change = (next - R).cwiseAbs().maxCoeff();
+    R = next;
+    if (change < 1e-14) break;
+  }
+  return R;
+}
+
+// The Maxwell branch over one increment (see MaterialPoint): exact for s_e linear in time.
+void relax(const TissueMaterial& m, const Eigen::Matrix3d& f, double dt_ms, const Eigen::Matrix3d& elastic_deviator,
+           const MaterialPoint& before, MaterialPoint& after) {
+  const Eigen::Matrix3d R = polar_rotation(f);
+  const Eigen::Matrix3d q_n = R * before.relaxed_stress_MPa * R.transpose();
+  const Eigen::Matrix3d s_n = R * before.elastic_deviator_MPa * R.transpose();
+  const double g = m.relaxing_shear_fraction, tau = m.relaxation_time_ms;
+  if (dt_ms > 0) {
+    const double ratio = dt_ms / tau, a = std::exp(-ratio);
+    // 1 - (1 - a) / ratio, by its series where the division would lose digits.
+    const double lag = ratio < 1e-4 ? ratio / 2 - ratio * ratio / 6 : 1 - (1 - a) / ratio;
+    // q_n+1 = a q_n + g [(1 - a) s_n + lag (s_n+1 - s_n)]
+    after.relaxed_stress_MPa = a * q_n + g * ((1 - a) * s_n + lag * (elastic_deviator - s_n));
+  } else {
+    after.relaxed_stress_MPa = q_n;
+  }
+  after.elastic_deviator_MPa = elastic_deviator;
+}
+
+}  // namespace
 
 StressUpdate update_stress(const TissueMaterial& m, const MaterialPoint& state, const Eigen::Matrix3d& f, double dt_ms) {
   const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
@@ -140,6 +182,10 @@ StressUpdate update_stress(const TissueMaterial& m, const MaterialPoint& state, 
   out.state.elastic_left_cauchy_green = V * (2.0 * h).array().exp().matrix().asDiagonal() * V.transpose();
   out.state.plastic_strain = eps_p;
   out.cauchy_stress_MPa = V * sigma_principal.asDiagonal() * V.transpose();
+  if (m.viscoelastic()) {
+    relax(m, f, dt_ms, V * s.asDiagonal() * V.transpose(), state, out.state);
+    out.cauchy_stress_MPa -= out.state.relaxed_stress_MPa;
+  }
   out.rate_factor_capped = capped;
   const Eigen::Vector3d h_dev_final = h.array() - h.mean();
   out.effective_strain = eps_p + std::sqrt(2.0 / 3.0 * h_dev_final.squaredNorm());

@@ -47,9 +47,16 @@ struct TissueMaterial {
   double rate_C_per_ms = 0.1;  // Cowper-Symonds C
   double rate_p = 0.1;         // Cowper-Symonds p (exponent 1/p for `printed`, p for `plausible`)
   double max_rate_factor = 1e3;
+  // Viscoelastic relaxation of the shear stress (one Maxwell branch, off by default): a step of shear
+  // strain held still gives the deviatoric stress s(t) = s_0 (1 - g (1 - exp(-t / tau))), g the
+  // relaxing shear fraction and tau the relaxation time. E is the instantaneous modulus (the wave speed
+  // and stable step are unchanged); (1 - g) E is the relaxed one. The paper's card has none (g = 0).
+  double relaxing_shear_fraction = 0.0;  // g in [0, 1)
+  double relaxation_time_ms = 1.0;       // tau > 0
+  bool viscoelastic() const { return relaxing_shear_fraction > 0; }
 
   // InputError naming the bad field: E <= 0, nu outside (-1, 0.5), density <= 0, k <= 0, n <= 1, ...
-  void validate() const;
+  void validate() const;  // also g outside [0, 1), tau <= 0
 
   double density_g_per_mm3() const { return density_g_per_cm3 * 1e-3; }
   double shear_modulus_MPa() const { return E_MPa / (2 * (1 + nu)); }
@@ -78,9 +85,19 @@ struct TissueMaterial {
 // Jaumann-rate form it stays stable when the stress exceeds the shear modulus (elastic strains near 1,
 // which this soft card reaches). Plasticity: multiplicative, J2 return mapping in principal log strain
 // (exponential map), so plastic flow is exactly volume preserving.
+//
+// Viscoelastic relaxation (TissueMaterial::viscoelastic): the Maxwell branch's stress q obeys
+// dq/dt = (g s_e - q) / tau, s_e the deviatoric stress of the elastic(-plastic) update above, and the
+// Cauchy stress is that update's minus q. s_e is taken linear in time over the increment, which this
+// integrates exactly; q and the last s_e are carried with the increment's rotation (polar part of f), so
+// the update stays objective. Relaxation acts after the return mapping: it lowers a stress below yield and
+// never raises one, and its dissipation shows as internal work (the solver's energy balance integrates
+// the stress power).
 struct MaterialPoint {
   Eigen::Matrix3d elastic_left_cauchy_green = Eigen::Matrix3d::Identity();  // b_e
   double plastic_strain = 0.0;
+  Eigen::Matrix3d relaxed_stress_MPa = Eigen::Matrix3d::Zero();      // q (viscoelastic only)
+  Eigen::Matrix3d elastic_deviator_MPa = Eigen::Matrix3d::Zero();    // s_e of the last update (viscoelastic only)
 };
 
 struct StressUpdate {
