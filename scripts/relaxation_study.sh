@@ -57,7 +57,7 @@ for v in "${variants[@]}"; do
 done
 mv "$csv.partial" "$csv"
 
-awk -F, 'NR > 1 { k = $2 ":" $3; d[$1, k] = $4; s[$1, k] = $8; if (!(k in seen)) { seen[k] = 1; order[++m] = k } }
+awk -F, 'NR > 1 { k = $2 == 0 ? "0 (elastic)" : $2 ":" $3; d[$1, k] = $4; s[$1, k] = $8; if (!(k in seen)) { seen[k] = 1; order[++m] = k } }
 END {
   printf "%-14s %10s %10s %9s   %s\n", "g:tau (ms)", "SB", "AMB", "AMB/SB", "(delta in mm at 10 mm)"
   for (i = 1; i <= m; ++i) {
