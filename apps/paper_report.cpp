@@ -80,9 +80,11 @@ NeedleRun read_run(const std::string& out_dir, const std::string& name) {
           tissue_law_from_name(t["material"].value("law", tissue_law_name(TissueLaw::mat018))) == TissueLaw::stiffening_elastic)
         r.model_description += "; the tissue stiffens as measured (stiffening_elastic: 3 G eps + k eps^n)";
       // The card has no relaxation and goes unnamed; a viscoelastic gel is said.
-      if (t.contains("material") && t["material"].value("relaxing_shear_fraction", 0.0) > 0)
+      const json material = t.value("material", json::object());
+      const double relaxing_share = material.value("relaxing_shear_fraction", 0.0);
+      if (relaxing_share > 0)
         r.model_description += fmt::format("; the gel relaxes viscoelastically ({:g} of the shear stress, time constant {:g} ms)",
-                                           t["material"].value("relaxing_shear_fraction", 0.0), t["material"].value("relaxation_time_ms", 1.0));
+                                           relaxing_share, material.value("relaxation_time_ms", TissueMaterial{}.relaxation_time_ms));
       // The paper's 40 x 8 x 2 mm half block goes unnamed; another block is said.
       const TissueScene paper_block;
       if (t.contains("size_mm") && t["size_mm"].is_array() && t["size_mm"].size() == 3) {

@@ -43,7 +43,7 @@ csv="$out/relaxation_study.csv"
 echo "needle,relaxing_shear_fraction,relaxation_time_ms,deflection_mm,coupling_steps,max_energy_balance_error,runtime_s,status" > "$csv.partial"
 for v in "${variants[@]}"; do
   # shellcheck disable=SC2046  # flags are words
-  { study_run relaxation_study "$out/SB_$(name_of "$v")" SB --path-refinement 2 $(flags_of "$v") & } 
+  { study_run relaxation_study "$out/SB_$(name_of "$v")" SB --path-refinement 2 $(flags_of "$v") & }
   # shellcheck disable=SC2046
   { study_run relaxation_study "$out/AMB_$(name_of "$v")" AMB --path-refinement 2 $(flags_of "$v") & }
   wait

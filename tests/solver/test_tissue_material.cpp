@@ -11,6 +11,16 @@
 
 using namespace needle;
 
+namespace {
+
+// An isochoric stretch of log stretch ln l: F = diag(l, l^-1/2, l^-1/2).
+Eigen::Matrix3d isochoric(double log_stretch) {
+  const double l = std::exp(log_stretch);
+  return Eigen::Vector3d(l, 1 / std::sqrt(l), 1 / std::sqrt(l)).asDiagonal();
+}
+
+}  // namespace
+
 TEST_CASE("Bad tissue cards and kernel parameters are refused with the field named", "[solver][material]") {
   auto refused = [](TissueMaterial m) { CHECK_THROWS_AS(m.validate(), InputError); };
   TissueMaterial m;
@@ -141,14 +151,10 @@ TEST_CASE("The stiffening law: an isochoric stretch gives q = 3 G eps + k eps^n,
   m.law = TissueLaw::stiffening_elastic;
   m.E_MPa = 0.03;
   const double eps = 1.2, shear = m.E_MPa / (2 * (1 + m.nu));
-  const auto stretch = [](double log_stretch) {
-    const double l = std::exp(log_stretch);
-    return Eigen::Matrix3d(Eigen::Vector3d(l, 1 / std::sqrt(l), 1 / std::sqrt(l)).asDiagonal());
-  };
   MaterialPoint state;
   StressUpdate u;
   for (int k = 0; k < 60; ++k) {
-    u = update_stress(m, state, stretch(eps / 60), 0.01);
+    u = update_stress(m, state, isochoric(eps / 60), 0.01);
     state = u.state;
   }
   const Eigen::Matrix3d& sigma = u.cauchy_stress_MPa;
@@ -156,15 +162,15 @@ TEST_CASE("The stiffening law: an isochoric stretch gives q = 3 G eps + k eps^n,
   CHECK(sigma.trace() == Approx(0).margin(1e-12));
   CHECK(u.effective_strain == Approx(eps).epsilon(1e-9));
   CHECK(u.state.plastic_strain == 0);
-  const StressUpdate once = update_stress(m, MaterialPoint{}, stretch(eps), 0.01);
+  const StressUpdate once = update_stress(m, MaterialPoint{}, isochoric(eps), 0.01);
   CHECK((once.cauchy_stress_MPa - sigma).norm() < 1e-6 * sigma.norm());  // 60 eigen-decompositions against one
-  const StressUpdate back = update_stress(m, state, stretch(-eps), 0.01);
+  const StressUpdate back = update_stress(m, state, isochoric(-eps), 0.01);
   CHECK(back.cauchy_stress_MPa.norm() < 1e-12);
   // The paper's card at the same E yields early and ends far below the measured curve k eps^n.
   TissueMaterial card;
   card.E_MPa = m.E_MPa;
   card.rate_law = RateLaw::off;
-  const StressUpdate card_once = update_stress(card, MaterialPoint{}, stretch(eps), 0.01);
+  const StressUpdate card_once = update_stress(card, MaterialPoint{}, isochoric(eps), 0.01);
   CHECK(card_once.cauchy_stress_MPa(0, 0) - card_once.cauchy_stress_MPa(1, 1) < 0.5 * m.k_MPa * std::pow(eps, m.n));
 }
 
@@ -205,12 +211,6 @@ TEST_CASE("Uniaxial tension of a particle specimen follows the stiffening law's 
 }
 
 namespace {
-
-// An isochoric stretch increment: diag(l, l^-1/2, l^-1/2).
-Eigen::Matrix3d isochoric(double log_stretch) {
-  const double l = std::exp(log_stretch);
-  return Eigen::Vector3d(l, 1 / std::sqrt(l), 1 / std::sqrt(l)).asDiagonal();
-}
 
 Eigen::Matrix3d deviator(const Eigen::Matrix3d& s) { return s - s.trace() / 3 * Eigen::Matrix3d::Identity(); }
 
