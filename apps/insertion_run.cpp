@@ -273,6 +273,8 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
       {"bond_cut_s", run.bond_cut_s()},
       {"slit", {{"particles_opened", run.particles_opened_by_slit()}, {"max_opening_mm", slit_opening.max_mm},
                 {"mean_opening_mm", slit_opening.mean_mm}}},
+      {"cutting", {{"pressure_MPa", scene.tissue.contact.cutting_pressure_MPa}, {"work_mJ", run.contact_model().cutting_work_mJ()},
+                   {"force_at_end_N", run.contact().cutting_force_N}}},
       {"groove",
        {{"groove_fill", groove.groove_fill},
         {"floor_contact_fraction", groove.floor_contact_fraction},
@@ -371,6 +373,7 @@ void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
     if (!std::isnan(o.relaxation_time_ms)) scene.tissue.material.relaxation_time_ms = o.relaxation_time_ms;
     scene.tissue.material.validate();
   }
+  if (given_or_zero(o.cutting_pressure_MPa, "--cutting-pressure-mpa")) scene.tissue.contact.cutting_pressure_MPa = o.cutting_pressure_MPa;
 }
 
 void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
@@ -411,6 +414,9 @@ void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
                 "tissue.material.relaxing_shear_fraction)");
   c->add_option("--relaxation-time-ms", o.relaxation_time_ms,
                 "The relaxation's time constant tau (default 1 ms; scene key tissue.material.relaxation_time_ms)");
+  c->add_option("--cutting-pressure-mpa", o.cutting_pressure_MPa,
+                "Cutting resistance: a pressure on the tip facets that advance into the tissue, the work of separating it "
+                "(default 0: cutting costs nothing, as in the paper's model; scene key tissue.contact.cutting_pressure_MPa)");
 }
 
 std::string scene_override_arguments(const SceneOverrides& o) {
@@ -430,6 +436,7 @@ std::string scene_override_arguments(const SceneOverrides& o) {
   if (!std::isnan(o.slit_half_height_mm)) line += fmt::format(" --slit-half-height-mm {}", o.slit_half_height_mm);
   if (!std::isnan(o.relaxing_shear_fraction)) line += fmt::format(" --relaxing-shear-fraction {}", o.relaxing_shear_fraction);
   if (!std::isnan(o.relaxation_time_ms)) line += fmt::format(" --relaxation-time-ms {}", o.relaxation_time_ms);
+  if (!std::isnan(o.cutting_pressure_MPa)) line += fmt::format(" --cutting-pressure-mpa {}", o.cutting_pressure_MPa);
   return line;
 }
 

@@ -98,6 +98,11 @@ NeedleRun read_run(const std::string& out_dir, const std::string& name) {
       if (slit_mm > 0)
         r.model_description += fmt::format("; the tissue also splits in the symmetry plane behind the tip, {:g} mm either side of the rod's axis",
                                            slit_mm);
+      // No cutting resistance is the default and goes unnamed; a resistance is said.
+      const double cutting_MPa = t.contains("contact") ? t["contact"].value("cutting_pressure_MPa", 0.0) : 0.0;
+      if (cutting_MPa > 0)
+        r.model_description += fmt::format("; cutting the tissue costs work: a pressure of {:g} MPa on the tip facets that advance into it",
+                                           cutting_MPa);
     }
     // The paper's drive (8 m/s, read at full speed) goes unnamed; another speed, a stop or a hold is said.
     const InsertionProfile paper_drive;

@@ -134,6 +134,7 @@ void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc) {
     t.contact.cuts_bonds = c.boolean("cuts_bonds", t.contact.cuts_bonds);
     t.contact.slit.half_height_mm = c.quantity("slit_half_height", Dimension::length, t.contact.slit.half_height_mm, non_negative());
     t.contact.slit.lead_mm = c.quantity("slit_lead", Dimension::length, t.contact.slit.lead_mm, non_negative());
+    t.contact.cutting_pressure_MPa = c.quantity("cutting_pressure", Dimension::stress, t.contact.cutting_pressure_MPa, non_negative());
     c.finish();
   }
   o.finish();
@@ -224,6 +225,7 @@ json scene_to_json(const Scene& s) {
     tissue["contact"]["slit_half_height_mm"] = t.contact.slit.half_height_mm;
     tissue["contact"]["slit_lead_mm"] = t.contact.slit.lead_mm;
   }
+  if (t.contact.cutting_pressure_MPa > 0) tissue["contact"]["cutting_pressure_MPa"] = t.contact.cutting_pressure_MPa;
   const CannulaOptions& c = s.cannula;
   json motion = {{"accel_time_ms", s.motion.accel_time_ms}, {"speed_m_per_s", s.motion.speed_mm_per_ms}, {"travel_mm", s.motion.travel_mm},
                  {"direction", vector_json(s.direction)}};

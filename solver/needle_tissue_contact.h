@@ -19,6 +19,18 @@
 // The particle gets f = f_n + f_t; the needle gets -f on the three nodes of that triangle by
 // barycentric weights. Forces are booked per facet tag (top, bottom, sides, lancets, groove floor ...).
 //
+// Cutting resistance (cutting_pressure_MPa = p_c > 0, off by default): separating the tissue at the tip
+// costs work (its fracture energy), which the penalty above never asks for: the needle's cut
+// (needle_bond_cut.h) breaks bonds for free. Every triangle of a tip facet (top, bottom, side_*,
+// lancet_*) whose centroid lies in the tissue block (the box of the particles at the start, grown by half
+// a spacing) and that advances into it (outward normal n, n . v > 0) is loaded with -p_c A n, a third on
+// each corner. (The block, not the particles in contact: particles coarser than the facet's triangles
+// touch only some of them.) It does the work p_c A n . v per unit time, booked as dissipation
+// (with friction). Per millimetre of advance the needle then pays p_c times the tip's frontal area in
+// contact: a fracture energy G_c = p_c A_frontal / w for a cut of width w. The reaction goes to the crack
+// front, which the particles do not resolve; it is left out of the tissue (its momentum is the needle's
+// drive's). The facets' normals set how the resistance bends the needle, as the paper's tip forces do.
+//
 // Multi-rate integration over one tissue step [t, t + Dt] (lspg_insertion.h):
 //   begin_step: the particles move on straight lines over the step (velocity Verlet's drift), so their
 //     path is known. The geometry (triangle, weights, normal, phi) is found once, at t, for every particle
@@ -34,6 +46,7 @@
 // the tests. (Giving the particles the step's mean force instead would exchange momentum exactly, but
 // it evaluates the penalty half a step late for them, which pumps energy in: tried and rejected.)
 #include <Eigen/Dense>
+#include <Eigen/Geometry>
 #include <limits>
 #include <string>
 #include <utility>
@@ -55,6 +68,9 @@ struct ContactOptions {
   bool cuts_bonds = true;         // the needle breaks the tissue bonds its body passes through (needle_bond_cut.h);
                                   // false: only the tissue's failure criterion separates particles
   SymmetrySlitOptions slit;       // the tissue also opens in the symmetry plane behind the tip (symmetry_slit.h); off by default
+  // Cutting resistance (MPa): the work of separating the tissue at the tip, as a pressure on the tip's
+  // facets (see below). 0: cutting costs nothing, the paper's model and the default.
+  double cutting_pressure_MPa = 0.0;
   void validate(const std::string& where = "contact") const;  // InputError naming the bad field
 };
 
@@ -64,6 +80,7 @@ struct FacetContact {
   double normal_N = 0;    // sum of |f_n|
   double friction_N = 0;  // sum of |f_t|
   Eigen::Vector3d force_N = Eigen::Vector3d::Zero();  // total force on the needle
+  Eigen::Vector3d cutting_force_N = Eigen::Vector3d::Zero();  // the cutting resistance's share of it
 };
 
 struct ContactReport {
@@ -72,6 +89,7 @@ struct ContactReport {
   double max_depth_mm = 0;           // deepest such point below the true surface
   double penalty_energy_mJ = 0;      // sum 1/2 k g^2
   double friction_power_mW = 0;      // rate of dissipation by friction and normal damping (>= 0)
+  double cutting_force_N = 0;        // the cutting resistance's magnitude, sum of p_c A over the loaded triangles
   Eigen::Vector3d force_on_needle_N = Eigen::Vector3d::Zero();
   std::vector<FacetContact> facets;  // indexed like ContactSurface::tag_names()
 };
@@ -104,8 +122,10 @@ class NeedleTissueContact {
   // The state of the last force evaluation (in contact, forces per facet, energy) and of the last
   // begin_step (particles inside).
   const ContactReport& report() const { return report_; }
-  // Energy dissipated by friction and normal damping since the start.
+  // Energy dissipated by friction, normal damping and the cutting resistance since the start.
   double friction_dissipation_mJ() const { return friction_dissipation_mJ_; }
+  // The cutting resistance's share of it.
+  double cutting_work_mJ() const { return cutting_work_mJ_; }
   // Sum of the penalty energy's jumps where each step finds the geometry anew (the gap is linearised
   // within a step): energy the contact's discretisation adds (> 0) or removes. A diagnostic.
   double relinearisation_energy_mJ() const { return relinearisation_energy_mJ_; }
@@ -146,6 +166,9 @@ class NeedleTissueContact {
   void probe(const std::vector<Vec3d>& x, const Eigen::MatrixX3d& needle_x, const std::vector<double>& reach);
   Eigen::Vector3d surface_point(const Pair& pair, const Eigen::MatrixX3d& needle) const;
   void record_contacts();  // contacts_ from the last evaluation (at a step's end, not at every substep)
+  // The cutting resistance on the tip facets' triangles in the tissue block; returns its power (mW).
+  double add_cutting_resistance(const Eigen::MatrixX3d& needle_x, const Eigen::MatrixX3d& needle_v,
+                                std::vector<std::pair<int, Eigen::Vector3d>>& force_N);
 
   const ContactSurface& surface_;
   ContactOptions options_;
@@ -162,6 +185,10 @@ class NeedleTissueContact {
   std::vector<int> previous_particles_;                       // ... and their particles
   std::vector<std::pair<int, int>> contacts_;                 // (particle, triangle) in contact at the last step's end
   double step_start_ms_ = 0, step_dt_ms_ = 0, last_eval_ms_ = 0, last_friction_power_mW_ = 0, friction_dissipation_mJ_ = 0, relinearisation_energy_mJ_ = 0;
+  double last_cutting_power_mW_ = 0, cutting_work_mJ_ = 0;
+  std::vector<int> cutting_triangles_;           // the tip facets' triangles (only with a cutting pressure)
+  std::vector<double> cutting_orientation_;      // +1 or -1 per triangle of the surface: turns its winding's normal outward (forward)
+  Eigen::AlignedBox3d cutting_block_;            // the tissue block the tip cuts (particles at the start, grown by half a spacing)
   ContactReport report_;
   // Grid of the current surface nodes (rebuilt per query): sorted (cell, node).
   double node_cell_mm_ = 0;

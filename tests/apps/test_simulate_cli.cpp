@@ -462,3 +462,54 @@ TEST_CASE("needle run --relaxing-shear-fraction: the scene says so, the relaxed 
     CHECK(!fs::exists(dir / "run"));
   }
 }
+
+TEST_CASE("needle run --cutting-pressure-mpa: the scene says so, the tip pays the cutting work, bad input is refused",
+          "[apps][lspg][gmsh][cutting]") {
+  // A 26 mm SB pushed 0.8 mm into the small block with and without a cutting pressure of 0.2 MPa: the key is written only
+  // when on; the work goes into the summary and into the balance (which must still close); the needle is held back harder.
+  auto run_sb = [](const std::string& name, const std::string& flags) {
+    const fs::path dir = fresh_folder(name);
+    write(dir / "scene.json", R"({"needle": {"preset": "SB", "length_mm": 26, "mesh": {"order": 1, "size_mm": 0.5}},)"
+                              R"("motion": {"accel_time_ms": 0.02, "travel_mm": 0.8}, "cannula": {"enabled": false},)"
+                              R"("tissue": {"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4}, "solver": {"mass_scaling_dt_ms": 1e-5},)"
+                              R"("output": {"frames": 0, "history_interval_ms": 0.02}})");
+    const auto r = run("run --scene " + (dir / "scene.json").string() + " --out " + (dir / "run").string() + " --quiet " + flags, true);
+    INFO(r.out);
+    REQUIRE(r.exit_code == 0);
+    std::ifstream scene_file(dir / "run" / "scene.json"), summary_file(dir / "run" / "summary.json");
+    return RunFiles{nlohmann::json::parse(scene_file), nlohmann::json::parse(summary_file),
+                    needle::read_csv_table((dir / "run" / "history.csv").string())};
+  };
+  const RunFiles free_cut = run_sb("cutting_free", "");
+  const RunFiles paid_cut = run_sb("cutting_paid", "--cutting-pressure-mpa 0.2");
+  CHECK_FALSE(free_cut.scene["tissue"]["contact"].contains("cutting_pressure_MPa"));
+  CHECK(paid_cut.scene["tissue"]["contact"]["cutting_pressure_MPa"].get<double>() == 0.2);
+  CHECK(free_cut.summary["cutting"]["work_mJ"].get<double>() == 0.0);
+  const double work_mJ = paid_cut.summary["cutting"]["work_mJ"].get<double>();
+  const double free_drag_N = std::abs(free_cut.history.column("contact_force_x_N").back());
+  const double paid_drag_N = std::abs(paid_cut.history.column("contact_force_x_N").back());
+  INFO("cutting work " << work_mJ << " mJ; drag " << free_drag_N << " N free, " << paid_drag_N << " N paid; balance "
+                       << paid_cut.summary["energy_balance_error"]);
+  CHECK(work_mJ > 0);
+  CHECK(paid_drag_N > free_drag_N);
+  CHECK(paid_cut.summary["energy_mJ"]["friction_dissipation"].get<double>() > work_mJ);
+  CHECK(paid_cut.summary["energy_balance_error"].get<double>() < 0.02);
+
+  // A negative pressure, and a needle without tip facets to load (the plain rod): one line, exit 2, no run folder.
+  {
+    const fs::path dir = fresh_folder("cutting_negative");
+    const auto bad = run_rod_into_block(dir, R"({"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4})", 0.8, 0, "--cutting-pressure-mpa -1");
+    INFO(bad.out);
+    CHECK(bad.exit_code == 2);
+    CHECK(bad.out.find("--cutting-pressure-mpa must be a number >= 0") != std::string::npos);
+    CHECK(!fs::exists(dir / "run"));
+  }
+  {
+    const fs::path dir = fresh_folder("cutting_rod");
+    const auto bad = run_rod_into_block(dir, R"({"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4})", 0.8, 0, "--cutting-pressure-mpa 0.2");
+    INFO(bad.out);
+    CHECK(bad.exit_code == 2);
+    CHECK(bad.out.find("a cutting pressure needs a needle with tip facets") != std::string::npos);
+    CHECK(!fs::exists(dir / "run"));
+  }
+}

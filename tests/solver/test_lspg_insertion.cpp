@@ -2,8 +2,10 @@
 // tissue, Coulomb friction recovered by a sliding block, no particle left inside the needle, and the
 // subcycled / mass-scaled needle against the plain full model.
 #include <catch2/catch.hpp>
+#include <algorithm>
 #include <cmath>
 
+#include "geometry/exact_measures.h"
 #include "geometry/grinding_recipe.h"
 #include "mesher/needle_mesher.h"
 #include "mesher/particle_lattice.h"
@@ -237,4 +239,56 @@ TEST_CASE("Particles inside the contact skin at the start do not trip the energy
   // Once the drive has done the work, the balance holds as in the other runs.
   CHECK(e.drive_work_mJ > 10 * e.initial_penalty_energy_mJ);
   CHECK(e.balance_error() < 0.02);
+}
+
+TEST_CASE("A cutting pressure loads the tip facets along their normals and the balance books its work", "[solver][lspg][gmsh][cutting]") {
+  // The rigid SB tip driven 2 mm into the fixed-sides block, with and without a cutting pressure p_c.
+  // Closed forms: on the (planar) top facet the resistance is -p_c A n_top, so its direction is the
+  // facet's normal to rounding and its size at most p_c times the facet's exact area; over the run it
+  // does the work of that force along the drive. The work is dissipation: without booking it the
+  // energy balance would miss it by its whole size, several times the 2 % it is allowed.
+  const TipGeometry tip = short_tip("SB", 6.0);
+  const TetMesh mesh = small_needle(tip, true, 0.5);
+  const InsertionProfile profile = quick_profile(2.0);
+  const double pressure_MPa = 0.2;
+  ContactOptions contact;
+  contact.cutting_pressure_MPa = pressure_MPa;
+  Insertion ins(mesh, 0.0, true, profile, Eigen::Vector3d::UnitX(), block(3.0, 1.6, 1.2, 0.4, true), CouplingOptions{}, contact);
+  const double end = profile.end_time_ms();
+  const auto& names = ins.surface.tag_names();
+  const size_t top = static_cast<size_t>(std::find(names.begin(), names.end(), "top") - names.begin());
+  REQUIRE(top < names.size());
+  const auto top_facet = std::find_if(tip.facets.begin(), tip.facets.end(), [](const FacetPlane& f) { return f.name == "top"; });
+  REQUIRE(top_facet != tip.facets.end());
+  const Eigen::Vector3d n_top = top_facet->normal;
+  const double top_area_half_mm2 = 0.5 * exact_facet_area_mm2(tip, static_cast<int>(top_facet - tip.facets.begin()));
+  double work_along_drive_mJ = 0, last_force_x = 0, largest_top_N = 0;
+  while (ins.run.time_ms() < end - 1e-12) {
+    const double t0 = ins.run.time_ms();
+    ins.run.step(end);
+    const double dt = ins.run.time_ms() - t0;
+    Eigen::Vector3d cutting = Eigen::Vector3d::Zero();
+    for (const FacetContact& f : ins.run.contact().facets) cutting += f.cutting_force_N;
+    // Trapezoid of -F_x v over the step (the rigid needle moves at the profile's speed along x).
+    const double v0 = profile.velocity_mm_per_ms(t0), v1 = profile.velocity_mm_per_ms(ins.run.time_ms());
+    work_along_drive_mJ += 0.5 * dt * (-last_force_x * v0 - cutting.x() * v1);
+    last_force_x = cutting.x();
+    const Eigen::Vector3d on_top = ins.run.contact().facets[top].cutting_force_N;
+    if (on_top.norm() > 0) {
+      CHECK(on_top.normalized().dot(-n_top) == Approx(1.0).epsilon(1e-9));
+      largest_top_N = std::max(largest_top_N, on_top.norm());
+    }
+  }
+  const InsertionEnergy& e = ins.run.energy();
+  const double cutting_mJ = ins.run.contact_model().cutting_work_mJ();
+  INFO("cutting work " << cutting_mJ << " mJ, along the drive " << work_along_drive_mJ << " mJ, drive " << e.drive_work_mJ
+                       << " mJ, balance " << e.balance_error() << "; top facet " << largest_top_N << " N against p_c A/2 "
+                       << pressure_MPa * top_area_half_mm2 << " N");
+  CHECK(largest_top_N > 0.2 * pressure_MPa * top_area_half_mm2);
+  CHECK(largest_top_N <= pressure_MPa * top_area_half_mm2 * (1 + 1e-6));
+  CHECK(cutting_mJ > 0.08 * e.drive_work_mJ);
+  CHECK(cutting_mJ == Approx(work_along_drive_mJ).epsilon(0.02));
+  CHECK(e.friction_dissipation_mJ > cutting_mJ);
+  CHECK(e.balance_error() < 0.02);
+  CHECK(ins.run.max_energy_error() < 0.02);
 }
