@@ -1,0 +1,70 @@
+#!/usr/bin/env bash
+# Does the cost of cutting move the balance of the tips' loads? The needle's cut breaks the tissue's bonds
+# for free, so the tips meet only the tissue's elastic push and the held loads behind the tip (the groove
+# floor, the shaft) bend the needles. A gel must be fractured at the tip: --cutting-pressure-mpa p_c loads
+# the tip facets in the block with p_c along their normals (docs/insertion.md), so a single bevel is pushed
+# down and the bevels of a multi-bevel tip push against each other. Runs the needles 10 mm into
+# data/scenes/spacing_study_10mm.json (0.2 mm particles near the path, the card at E 0.0748 MPa) for each
+# pressure and prints delta and the ratios to SB (docs/paper.md).
+#
+#   scripts/cutting_study.sh [OUT] [PRESSURE_MPa...]
+#       default: out/cutting, pressures 0 0.1 0.3
+#   NEEDLES="SB LMB AMB HMB" scripts/cutting_study.sh ...   (default NEEDLES="SB AMB"; SB must be among them)
+#
+# Two runs at once (one core each). A finished run (OUT/<needle>_p<p_c>/summary.json) is kept, so an
+# interrupted study resumes. About 10 min a run (19 683 particles).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+out="${1:-out/cutting}"
+shift || true
+[ -x build/apps/needle ] || bash scripts/build.sh
+mkdir -p "$out"
+
+pressures=("$@")
+[ "${#pressures[@]}" -gt 0 ] || pressures=(0 0.1 0.3)
+for p in "${pressures[@]}"; do
+  [[ "$p" =~ ^[0-9]*\.?[0-9]+$ ]] || { echo "cutting_study: '$p' is not a pressure in MPa (a number >= 0, e.g. 0.1)" >&2; exit 2; }
+done
+read -r -a needles <<< "${NEEDLES:-SB AMB}"
+[[ " ${needles[*]} " == *" SB "* ]] || { echo "cutting_study: NEEDLES must include SB (the ratios are to SB)" >&2; exit 2; }
+
+# shellcheck source=scripts/study_helpers.sh
+source scripts/study_helpers.sh
+
+csv="$out/cutting_study.csv"
+echo "needle,cutting_pressure_MPa,deflection_mm,cutting_work_mJ,coupling_steps,max_energy_balance_error,runtime_s,status" > "$csv.partial"
+for p in "${pressures[@]}"; do
+  flags=()
+  [[ "$p" =~ ^0*\.?0*$ ]] || flags=(--cutting-pressure-mpa "$p")
+  for ((i = 0; i < ${#needles[@]}; i += 2)); do
+    { study_run cutting_study "$out/${needles[i]}_p$p" "${needles[i]}" --path-refinement 2 "${flags[@]}" & }
+    if [ $((i + 1)) -lt ${#needles[@]} ]; then
+      { study_run cutting_study "$out/${needles[i + 1]}_p$p" "${needles[i + 1]}" --path-refinement 2 "${flags[@]}" & }
+    fi
+    wait
+  done
+  for needle in "${needles[@]}"; do
+    s="$out/${needle}_p$p/summary.json"
+    [ -f "$s" ] || { echo "cutting_study: no summary in $out/${needle}_p$p" >&2; exit 1; }
+    echo "$needle,$p,$(summary_number deflection_mm "$s"),$(summary_number work_mJ "$s"),$(summary_run_fields "$s")" >> "$csv.partial"
+  done
+done
+mv "$csv.partial" "$csv"
+
+awk -F, 'NR > 1 { d[$1, $2] = $3; s[$1, $2] = $8; if (!($2 in seen)) { seen[$2] = 1; order[++m] = $2 } if (!($1 in known)) { known[$1] = 1; needle[++k] = $1 } }
+END {
+  printf "%-10s", "p_c (MPa)"
+  for (j = 1; j <= k; ++j) printf " %9s", needle[j]
+  for (j = 1; j <= k; ++j) if (needle[j] != "SB") printf " %9s", needle[j] "/SB"
+  printf "   (delta in mm at 10 mm)\n"
+  for (i = 1; i <= m; ++i) {
+    p = order[i]; bad = 0
+    printf "%-10s", p
+    for (j = 1; j <= k; ++j) { printf " %+9.3f", d[needle[j], p]; if (s[needle[j], p] != "finished") bad = 1 }
+    for (j = 1; j <= k; ++j) if (needle[j] != "SB") printf " %9.2f", d["SB", p] != 0 ? d[needle[j], p] / d["SB", p] : 0
+    if (bad) printf "   a run stopped: see its summary.json"
+    printf "\n"
+  }
+  printf "experiment at 30 mm: SB -1.14, LMB +0.15, AMB +0.24, HMB +1.71 (LMB/SB -0.13, AMB/SB -0.21, HMB/SB -1.50)\n"
+}' "$csv"
+echo "table: $csv; runs in $out/<needle>_p<p_c>"
