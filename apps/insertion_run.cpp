@@ -181,6 +181,10 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
   const ContactSurface surface(needle.mesh(), surface_options);
   const ParticleSet particles = scene_particles(scene);
   SpgTissue tissue(particles, scene.tissue.material, scene.tissue.spg);
+  ContactOptions contact = scene.tissue.contact;
+  contact.cutting_facets = built.tip_facets;
+  NEEDLE_REQUIRE(contact.cutting_pressure_MPa == 0 || !contact.cutting_facets.empty(),
+                 "a cutting pressure needs a needle with tip facets: a ground tip from a preset, d_a or a recipe (not a plain rod or a mesh file)");
   const double setup_s = std::chrono::duration<double>(Clock::now() - start).count();
 
   RunFolder folder(o.out_dir, o.overwrite);
@@ -203,7 +207,7 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
 
   NeedleDynamics needle_run(needle, driven_base_supports(needle.mesh(), scene.motion, scene.direction), scene.cannula.enabled ? std::optional<CannulaOptions>(scene.cannula) : std::nullopt,
                             scene_dynamics_options(scene));
-  LspgInsertion run(needle_run, tissue, surface, scene.tissue.contact, scene.solver.coupling);
+  LspgInsertion run(needle_run, tissue, surface, contact, scene.solver.coupling);
   const int tip = nearest_node(needle.mesh(), built.tip_point);
   const double end_ms = scene.motion.end_time_ms();
   log.line(fmt::format("run to {:.6g} ms: needle step {:.4g} ms, first coupling step {:.4g} ms (tissue {:.4g}, contact {:.4g})", end_ms,

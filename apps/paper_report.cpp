@@ -94,12 +94,13 @@ NeedleRun read_run(const std::string& out_dir, const std::string& name) {
                                              size.z(), paper_block.size_mm.x(), paper_block.size_mm.y(), paper_block.size_mm.z());
       }
       // No slit is the default and goes unnamed; a slit is said.
-      const double slit_mm = t.contains("contact") ? t["contact"].value("slit_half_height_mm", 0.0) : 0.0;
+      const json contact = t.value("contact", json::object());
+      const double slit_mm = contact.value("slit_half_height_mm", 0.0);
       if (slit_mm > 0)
         r.model_description += fmt::format("; the tissue also splits in the symmetry plane behind the tip, {:g} mm either side of the rod's axis",
                                            slit_mm);
       // No cutting resistance is the default and goes unnamed; a resistance is said.
-      const double cutting_MPa = t.contains("contact") ? t["contact"].value("cutting_pressure_MPa", 0.0) : 0.0;
+      const double cutting_MPa = contact.value("cutting_pressure_MPa", 0.0);
       if (cutting_MPa > 0)
         r.model_description += fmt::format("; cutting the tissue costs work: a pressure of {:g} MPa on the tip facets that advance into it",
                                            cutting_MPa);

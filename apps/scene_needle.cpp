@@ -34,6 +34,7 @@ SceneNeedle build_scene_needle(const NeedleScene& n) {
   out.tip_point = tip.tip_point;
   out.groove = tip.groove;
   out.radius_mm = tip.radius_mm;
+  if (!n.plain_rod) out.tip_facets = build.tip_facets;  // a plain rod's end is cut square, not ground
   out.mesh_seconds = build.mesh_seconds;
   return out;
 }

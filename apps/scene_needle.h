@@ -5,6 +5,7 @@
 #include <Eigen/Dense>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "apps/scene.h"
 #include "geometry/tip_geometry.h"
@@ -19,6 +20,7 @@ struct SceneNeedle {
   Eigen::Vector3d tip_point = Eigen::Vector3d::Zero();  // A (for a mesh file: its most distal node)
   std::optional<GrooveBox> groove;  // in the mesh's frame (absent for a mesh file or a groove-less tip)
   double radius_mm = 0.5;
+  std::vector<std::string> tip_facets;  // boundary tags of the tip's ground facets (none for a plain rod or a mesh file)
   double mesh_seconds = 0;
 };
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "geometry/input_error.h"
 #include "solver/parallel.h"
@@ -43,9 +44,9 @@ NeedleTissueContact::NeedleTissueContact(const ContactSurface& surface, const Ti
   }
   node_cell_mm_ = surface_.node_search_radius_mm();
   if (options_.cutting_pressure_MPa > 0) {
-    // The tip's facets all face forward (their outward normals have n_x = sin(theta) > 0 in the CAD frame),
-    // which orients each triangle whatever its winding.
-    const std::vector<std::string> tip_facets = {"top", "bottom", "side_pos", "side_neg", "lancet_pos", "lancet_neg"};
+    // The tip's ground facets all face forward (their outward normals have n_x = sin(theta) > 0 in the CAD
+    // frame), which orients each triangle whatever its winding.
+    const std::vector<std::string>& tip_facets = options_.cutting_facets;
     const Eigen::MatrixX3d& X = surface_.reference_positions();
     const Eigen::MatrixX3i& tri = surface_.triangles();
     cutting_orientation_.assign(static_cast<size_t>(surface_.num_triangles()), 0.0);
@@ -63,7 +64,9 @@ NeedleTissueContact::NeedleTissueContact(const ContactSurface& surface, const Ti
       cutting_orientation_[static_cast<size_t>(t)] = (b - a).cross(c - a).x() >= 0 ? 1.0 : -1.0;
       cutting_triangles_.push_back(t);
     }
-    NEEDLE_REQUIRE(!cutting_triangles_.empty(), "contact: a cutting pressure needs a needle with tip facets (top, bottom, side_*, lancet_*)");
+    NEEDLE_REQUIRE(!cutting_triangles_.empty(),
+                   fmt::format("contact: a cutting pressure needs a needle with tip facets; the surface has none of the tags {}",
+                               fmt::join(tip_facets, ", ")));
   }
 }
 

@@ -21,8 +21,8 @@
 //
 // Cutting resistance (cutting_pressure_MPa = p_c > 0, off by default): separating the tissue at the tip
 // costs work (its fracture energy), which the penalty above never asks for: the needle's cut
-// (needle_bond_cut.h) breaks bonds for free. Every triangle of a tip facet (top, bottom, side_*,
-// lancet_*) whose centroid lies in the tissue block (the box of the particles at the start, grown by half
+// (needle_bond_cut.h) breaks bonds for free. Every triangle of a tip facet (the surface tags listed in
+// cutting_facets: the tip's ground facets, which the caller takes from the tip geometry) whose centroid lies in the tissue block (the box of the particles at the start, grown by half
 // a spacing) and that advances into it (outward normal n, n . v > 0) is loaded with -p_c A n, a third on
 // each corner. (The block, not the particles in contact: particles coarser than the facet's triangles
 // touch only some of them.) It does the work p_c A n . v per unit time, booked as dissipation
@@ -71,6 +71,7 @@ struct ContactOptions {
   // Cutting resistance (MPa): the work of separating the tissue at the tip, as a pressure on the tip's
   // facets (see below). 0: cutting costs nothing, the paper's model and the default.
   double cutting_pressure_MPa = 0.0;
+  std::vector<std::string> cutting_facets;  // the surface tags it loads: the tip's ground facets (not a scene key)
   void validate(const std::string& where = "contact") const;  // InputError naming the bad field
 };
 

@@ -467,9 +467,9 @@ TEST_CASE("needle run --cutting-pressure-mpa: the scene says so, the tip pays th
           "[apps][lspg][gmsh][cutting]") {
   // A 26 mm SB pushed 0.8 mm into the small block with and without a cutting pressure of 0.2 MPa: the key is written only
   // when on; the work goes into the summary and into the balance (which must still close); the needle is held back harder.
-  auto run_sb = [](const std::string& name, const std::string& flags) {
+  auto run_sb = [](const std::string& name, const std::string& flags, const std::string& needle = R"("preset": "SB")") {
     const fs::path dir = fresh_folder(name);
-    write(dir / "scene.json", R"({"needle": {"preset": "SB", "length_mm": 26, "mesh": {"order": 1, "size_mm": 0.5}},)"
+    write(dir / "scene.json", R"({"needle": {)" + needle + R"(, "length_mm": 26, "mesh": {"order": 1, "size_mm": 0.5}},)"
                               R"("motion": {"accel_time_ms": 0.02, "travel_mm": 0.8}, "cannula": {"enabled": false},)"
                               R"("tissue": {"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4}, "solver": {"mass_scaling_dt_ms": 1e-5},)"
                               R"("output": {"frames": 0, "history_interval_ms": 0.02}})");
@@ -494,22 +494,23 @@ TEST_CASE("needle run --cutting-pressure-mpa: the scene says so, the tip pays th
   CHECK(paid_drag_N > free_drag_N);
   CHECK(paid_cut.summary["energy_mJ"]["friction_dissipation"].get<double>() > work_mJ);
   CHECK(paid_cut.summary["energy_balance_error"].get<double>() < 0.02);
+  // The loaded facets are the tip's own, whatever a recipe names them.
+  {
+    const fs::path recipe = fresh_folder("cutting_recipe") / "bevel.json";
+    write(recipe, R"({"name": "one bevel", "groove": {"length_mm": 22.0, "remaining_thickness_mm": 0.43, "start_behind_tip_mm": 3.0},)"
+                  R"("grinds": [{"name": "bevel", "tilt_deg": 23.5, "rotation_deg": 0, "depth_mm": 1.0}]})");
+    const RunFiles named = run_sb("cutting_named", "--cutting-pressure-mpa 0.2", R"("recipe": ")" + recipe.string() + R"(")");
+    CHECK(named.summary["cutting"]["work_mJ"].get<double>() > 0.5 * work_mJ);
+  }
 
   // A negative pressure, and a needle without tip facets to load (the plain rod): one line, exit 2, no run folder.
-  {
-    const fs::path dir = fresh_folder("cutting_negative");
-    const auto bad = run_rod_into_block(dir, R"({"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4})", 0.8, 0, "--cutting-pressure-mpa -1");
-    INFO(bad.out);
+  for (const auto& [flags, message] : {std::pair<std::string, std::string>{"--cutting-pressure-mpa -1", "--cutting-pressure-mpa must be a number >= 0"},
+                                       {"--cutting-pressure-mpa 0.2", "a cutting pressure needs a needle with tip facets"}}) {
+    const fs::path dir = fresh_folder("cutting_bad");
+    const auto bad = run_rod_into_block(dir, R"({"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4})", 0.8, 0, flags);
+    INFO(flags << ": " << bad.out);
     CHECK(bad.exit_code == 2);
-    CHECK(bad.out.find("--cutting-pressure-mpa must be a number >= 0") != std::string::npos);
-    CHECK(!fs::exists(dir / "run"));
-  }
-  {
-    const fs::path dir = fresh_folder("cutting_rod");
-    const auto bad = run_rod_into_block(dir, R"({"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4})", 0.8, 0, "--cutting-pressure-mpa 0.2");
-    INFO(bad.out);
-    CHECK(bad.exit_code == 2);
-    CHECK(bad.out.find("a cutting pressure needs a needle with tip facets") != std::string::npos);
+    CHECK(bad.out.find(message) != std::string::npos);
     CHECK(!fs::exists(dir / "run"));
   }
 }

@@ -253,6 +253,7 @@ TEST_CASE("A cutting pressure loads the tip facets along their normals and the b
   const double pressure_MPa = 0.2;
   ContactOptions contact;
   contact.cutting_pressure_MPa = pressure_MPa;
+  for (const FacetPlane& f : tip.facets) contact.cutting_facets.push_back(f.name);
   Insertion ins(mesh, 0.0, true, profile, Eigen::Vector3d::UnitX(), block(3.0, 1.6, 1.2, 0.4, true), CouplingOptions{}, contact);
   const double end = profile.end_time_ms();
   const auto& names = ins.surface.tag_names();
