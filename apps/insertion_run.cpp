@@ -277,6 +277,7 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
       {"bond_cut_s", run.bond_cut_s()},
       {"slit", {{"particles_opened", run.particles_opened_by_slit()}, {"max_opening_mm", slit_opening.max_mm},
                 {"mean_opening_mm", slit_opening.mean_mm}}},
+      {"crack", {{"reach_mm", scene.tissue.contact.crack.reach_mm}, {"bonds_cut", run.bonds_cut_by_crack()}}},
       {"cutting", {{"pressure_MPa", scene.tissue.contact.cutting_pressure_MPa}, {"work_mJ", run.contact_model().cutting_work_mJ()},
                    {"force_at_end_N", run.contact().cutting_force_N}}},
       {"groove",
@@ -378,6 +379,12 @@ void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
     scene.tissue.material.validate();
   }
   if (given_or_zero(o.cutting_pressure_MPa, "--cutting-pressure-mpa")) scene.tissue.contact.cutting_pressure_MPa = o.cutting_pressure_MPa;
+  if (given_or_zero(o.crack_reach_mm, "--crack-reach-mm")) scene.tissue.contact.crack.reach_mm = o.crack_reach_mm;
+  if (!o.crack_angles_deg.empty()) {
+    NEEDLE_REQUIRE(std::all_of(o.crack_angles_deg.begin(), o.crack_angles_deg.end(), [](double a) { return std::isfinite(a) && a >= -180 && a <= 180; }),
+                   fmt::format("--crack-angles-deg must be angles from -180 to 180 degrees (got {})", fmt::join(o.crack_angles_deg, ",")));
+    scene.tissue.contact.crack.angles_deg = o.crack_angles_deg;
+  }
 }
 
 void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
@@ -421,6 +428,14 @@ void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
   c->add_option("--cutting-pressure-mpa", o.cutting_pressure_MPa,
                 "Cutting resistance: a pressure on the tip facets that advance into the tissue, the work of separating it "
                 "(default 0: cutting costs nothing, as in the paper's model; scene key tissue.contact.cutting_pressure_MPa)");
+  c->add_option("--crack-reach-mm", o.crack_reach_mm,
+                "The tip drives a crack past the rod's outline: the bonds across planar fins that leave tip point A are cut as the "
+                "tip passes, up to this distance from A (the rod's radius is 0.5; default 0: the tissue separates along the "
+                "needle's surface only; scene key tissue.contact.crack_reach_mm)");
+  c->add_option("--crack-angles-deg", o.crack_angles_deg,
+                "The crack's fins, as directions in the cross-section from A: 0 toward +z (a horizontal crack at A's height), "
+                "90 up, -90 down, e.g. 0 or 48,-55 (default 0; scene key tissue.contact.crack_angles_deg)")
+      ->delimiter(',');
 }
 
 std::string scene_override_arguments(const SceneOverrides& o) {
@@ -441,6 +456,8 @@ std::string scene_override_arguments(const SceneOverrides& o) {
   if (!std::isnan(o.relaxing_shear_fraction)) line += fmt::format(" --relaxing-shear-fraction {}", o.relaxing_shear_fraction);
   if (!std::isnan(o.relaxation_time_ms)) line += fmt::format(" --relaxation-time-ms {}", o.relaxation_time_ms);
   if (!std::isnan(o.cutting_pressure_MPa)) line += fmt::format(" --cutting-pressure-mpa {}", o.cutting_pressure_MPa);
+  if (!std::isnan(o.crack_reach_mm)) line += fmt::format(" --crack-reach-mm {}", o.crack_reach_mm);
+  if (!o.crack_angles_deg.empty()) line += fmt::format(" --crack-angles-deg {}", fmt::join(o.crack_angles_deg, ","));
   return line;
 }
 

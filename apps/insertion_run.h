@@ -45,11 +45,14 @@ struct SceneOverrides {
   double relaxing_shear_fraction = std::nan("");  // viscoelastic relaxation of the shear stress (0: none, the card)
   double relaxation_time_ms = std::nan("");       // its time constant
   double cutting_pressure_MPa = std::nan("");     // the tissue's cutting resistance on the tip facets (0: none, the default)
+  double crack_reach_mm = std::nan("");           // the tip's crack runs this far from tip point A (0: none, the default)
+  std::vector<double> crack_angles_deg;           // its fins' directions in the cross-section (empty: the scene's; 0: horizontal)
 };
 // InputError naming the flag for a value that is not a positive number.
 void apply_scene_overrides(Scene& scene, const SceneOverrides& overrides);
 // The flags run, paper and calibrate share: --travel-mm, --spacing-mm, --path-refinement, --no-needle-cut, --tissue-nu,
-// --tissue-friction, --tissue-law, --speed-m-per-s, --decel-time-ms, --hold-ms, --tissue-size-mm, --slit-half-height-mm, --relaxing-shear-fraction, --relaxation-time-ms, --cutting-pressure-mpa (each command
+// --tissue-friction, --tissue-law, --speed-m-per-s, --decel-time-ms, --hold-ms, --tissue-size-mm, --slit-half-height-mm, --relaxing-shear-fraction, --relaxation-time-ms, --cutting-pressure-mpa,
+// --crack-reach-mm, --crack-angles-deg (each command
 // adds --mesh-size-mm itself where it has it).
 void add_scene_override_options(CLI::App* command, SceneOverrides& overrides);
 // The flags that give these overrides again (each given value, with a leading space), for a command

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -99,6 +100,14 @@ NeedleRun read_run(const std::string& out_dir, const std::string& name) {
       if (slit_mm > 0)
         r.model_description += fmt::format("; the tissue also splits in the symmetry plane behind the tip, {:g} mm either side of the rod's axis",
                                            slit_mm);
+      // No crack past the rod is the default and goes unnamed; a crack is said.
+      const double crack_mm = contact.value("crack_reach_mm", 0.0);
+      if (crack_mm > 0) {
+        std::vector<double> angles = contact.value("crack_angles_deg", std::vector<double>{0.0});
+        r.model_description += fmt::format("; the tip drives a crack past the rod: fins from the tip point at {} deg in the cross-section "
+                                           "(0: horizontal), {:g} mm long",
+                                           fmt::join(angles, ", "), crack_mm);
+      }
       // No cutting resistance is the default and goes unnamed; a resistance is said.
       const double cutting_MPa = contact.value("cutting_pressure_MPa", 0.0);
       if (cutting_MPa > 0)

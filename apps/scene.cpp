@@ -135,6 +135,9 @@ void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc) {
     t.contact.slit.half_height_mm = c.quantity("slit_half_height", Dimension::length, t.contact.slit.half_height_mm, non_negative());
     t.contact.slit.lead_mm = c.quantity("slit_lead", Dimension::length, t.contact.slit.lead_mm, non_negative());
     t.contact.cutting_pressure_MPa = c.quantity("cutting_pressure", Dimension::stress, t.contact.cutting_pressure_MPa, non_negative());
+    t.contact.crack.reach_mm = c.quantity("crack_reach", Dimension::length, t.contact.crack.reach_mm, non_negative());
+    t.contact.crack.angles_deg = c.numbers("crack_angles_deg", t.contact.crack.angles_deg, within(-180.0, 180.0));
+    t.contact.crack.lead_mm = c.quantity("crack_lead", Dimension::length, t.contact.crack.lead_mm, non_negative());
     c.finish();
   }
   o.finish();
@@ -226,6 +229,11 @@ json scene_to_json(const Scene& s) {
     tissue["contact"]["slit_lead_mm"] = t.contact.slit.lead_mm;
   }
   if (t.contact.cutting_pressure_MPa > 0) tissue["contact"]["cutting_pressure_MPa"] = t.contact.cutting_pressure_MPa;
+  if (t.contact.crack.enabled()) {
+    tissue["contact"]["crack_reach_mm"] = t.contact.crack.reach_mm;
+    tissue["contact"]["crack_angles_deg"] = t.contact.crack.angles_deg;
+    tissue["contact"]["crack_lead_mm"] = t.contact.crack.lead_mm;
+  }
   const CannulaOptions& c = s.cannula;
   json motion = {{"accel_time_ms", s.motion.accel_time_ms}, {"speed_m_per_s", s.motion.speed_mm_per_ms}, {"travel_mm", s.motion.travel_mm},
                  {"direction", vector_json(s.direction)}};

@@ -166,6 +166,22 @@ Eigen::Vector3d SceneObject::vector3(const std::string& key, const Eigen::Vector
   return {v[0].get<double>(), v[1].get<double>(), v[2].get<double>()};
 }
 
+std::vector<double> SceneObject::numbers(const std::string& key, const std::vector<double>& fallback, const ValueCheck& check) {
+  used_.insert(key);
+  if (!has(key)) return fallback;
+  const nlohmann::json& v = object_.at(key);
+  NEEDLE_REQUIRE(v.is_array() && !v.empty(), fmt::format("{} must be a non-empty array of numbers", where(key)));
+  std::vector<double> out;
+  for (const auto& e : v) {
+    NEEDLE_REQUIRE(e.is_number(), fmt::format("{} must be a non-empty array of numbers", where(key)));
+    const double x = e.get<double>();
+    const std::string problem = check(x);
+    NEEDLE_REQUIRE(problem.empty(), fmt::format("{} {} (got {})", where(key), problem, x));
+    out.push_back(x);
+  }
+  return out;
+}
+
 SceneObject SceneObject::child(const std::string& key) {
   used_.insert(key);
   return SceneObject(doc_, pointer_ + "/" + json_pointer_token(key), name_.empty() ? key : name_ + "." + key);

@@ -6,6 +6,7 @@
 #include <functional>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "apps/json_lines.h"
 
@@ -33,6 +34,8 @@ class SceneObject {
   // Returns internal units (mm, ms, mm/ms, MPa, g/mm^3, deg).
   double quantity(const std::string& base, Dimension dimension, double fallback, const ValueCheck& check);
   Eigen::Vector3d vector3(const std::string& key, const Eigen::Vector3d& fallback);
+  // A non-empty array of numbers, each passing check.
+  std::vector<double> numbers(const std::string& key, const std::vector<double>& fallback, const ValueCheck& check);
   SceneObject child(const std::string& key);
   const nlohmann::json& raw(const std::string& key);  // marks the key read
   std::string where(const std::string& key) const;   // "file:line: name.key"

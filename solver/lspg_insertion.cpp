@@ -44,7 +44,8 @@ LspgInsertion::LspgInsertion(NeedleDynamics& needle, SpgTissue& tissue, const Co
       tissue_dynamics_(tissue, {}, coupling.tissue_body_acceleration_mm_per_ms2),
       contact_(surface, tissue.particles(), tissue.material(), contact),
       bond_cut_(surface),
-      slit_(needle.needle().mesh().X, contact.slit) {
+      slit_(needle.needle().mesh().X, contact.slit),
+      crack_(needle.needle().mesh().X, contact.crack) {
   options_.validate();
   NEEDLE_REQUIRE(needle.steps() == 0 && needle.time_ms() == 0, "the coupled run must start with a needle at t = 0");
   NEEDLE_REQUIRE(surface.reference_positions().rows() == needle.positions_mm().rows(),
@@ -121,6 +122,8 @@ void LspgInsertion::step(double end_time_ms) {
     bond_cut_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
   slit_.open(tissue_.particles(), needle_.positions_mm());
+  if (crack_.options().enabled())
+    bonds_cut_by_crack_ += tissue_.cut_bonds(crack_.bonds_across(tissue_.bonds(), tissue_.particles().position_mm, needle_.positions_mm()));
   ++steps_;
   last_dt_ms_ = dt;
   update_energy();

@@ -11,7 +11,8 @@
 //      stiff penalty is integrated exactly as a force of its own) and on the needle from the next step;
 //   3. the bonds the needle's body now passes through are cut (needle_bond_cut.h; ContactOptions::cuts_bonds),
 //      as the failure criterion breaks its bonds after a force evaluation: from the next step on; with a
-//      slit (symmetry_slit.h; ContactOptions::slit), the symmetry particles behind the tip are opened.
+//      slit (symmetry_slit.h; ContactOptions::slit), the symmetry particles behind the tip are opened; with a
+//      crack (tip_crack.h; ContactOptions::crack), the bonds across its fins at the tip are cut too.
 // Each step, the needle receives -C(t) Dt and the tissue (C(t) + C(t + Dt)) Dt / 2: momentum is exchanged
 // exactly up to a half-step lag that never accumulates (it telescopes to Dt/2 |C(end) - C(0)|). The lag is
 // stable because the steel's response to a force within one tissue step is tiny next to the contact's
@@ -32,6 +33,7 @@
 #include "solver/needle_bond_cut.h"
 #include "solver/needle_tissue_contact.h"
 #include "solver/symmetry_slit.h"
+#include "solver/tip_crack.h"
 
 namespace needle {
 
@@ -80,8 +82,9 @@ class LspgInsertion {
   int max_particles_inside() const { return max_inside_; }
   double max_depth_mm() const { return max_depth_; }
   long bonds_broken() const { return static_cast<long>(tissue_.bonds().broken_count); }
-  long bonds_cut_by_needle() const { return static_cast<long>(tissue_.bonds().cut_count); }
+  long bonds_cut_by_needle() const { return static_cast<long>(tissue_.bonds().cut_count - bonds_cut_by_crack_); }
   std::int64_t particles_opened_by_slit() const { return slit_.opened(); }
+  std::int64_t bonds_cut_by_crack() const { return bonds_cut_by_crack_; }
   double bond_cut_s() const { return bond_cut_s_; }  // wall time spent finding the bonds the needle cuts
   // Momenta (g mm/ms) and what the drive put in.
   Eigen::Vector3d tissue_momentum() const;
@@ -100,6 +103,8 @@ class LspgInsertion {
   NeedleTissueContact contact_;
   NeedleBondCut bond_cut_;
   SymmetrySlit slit_;
+  TipCrack crack_;
+  std::int64_t bonds_cut_by_crack_ = 0;
   double bond_cut_s_ = 0;
   InsertionEnergy energy_;
   bool in_step_ = false;

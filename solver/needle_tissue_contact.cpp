@@ -22,6 +22,7 @@ void ContactOptions::validate(const std::string& where) const {
   NEEDLE_REQUIRE(std::isfinite(voxel_mm) && voxel_mm >= 1e-3 && voxel_mm <= 0.2,
                  fmt::format("{}: voxel_mm must be in [0.001, 0.2] (got {})", where, voxel_mm));
   slit.validate(where + ".slit");
+  crack.validate(where + ".crack");
   NEEDLE_REQUIRE(std::isfinite(cutting_pressure_MPa) && cutting_pressure_MPa >= 0,
                  fmt::format("{}: cutting_pressure_MPa must be zero or positive (got {})", where, cutting_pressure_MPa));
 }

@@ -55,6 +55,7 @@
 #include "solver/contact_surface.h"
 #include "solver/spg_tissue.h"
 #include "solver/symmetry_slit.h"
+#include "solver/tip_crack.h"
 
 namespace needle {
 
@@ -68,6 +69,7 @@ struct ContactOptions {
   bool cuts_bonds = true;         // the needle breaks the tissue bonds its body passes through (needle_bond_cut.h);
                                   // false: only the tissue's failure criterion separates particles
   SymmetrySlitOptions slit;       // the tissue also opens in the symmetry plane behind the tip (symmetry_slit.h); off by default
+  TipCrackOptions crack;          // the tip drives a crack past the rod's outline (tip_crack.h); off by default
   // Cutting resistance (MPa): the work of separating the tissue at the tip, as a pressure on the tip's
   // facets (see below). 0: cutting costs nothing, the paper's model and the default.
   double cutting_pressure_MPa = 0.0;

@@ -56,6 +56,21 @@ RunFiles run_rod_into_small_block(const std::string& name, const std::string& fl
           needle::read_csv_table((dir / "run" / "history.csv").string())};
 }
 
+// A 26 mm SB (T4 0.5 mm, no cannula) pushed 0.8 mm into the small block.
+RunFiles run_sb_into_small_block(const std::string& name, const std::string& flags, const std::string& needle = R"("preset": "SB")") {
+  const fs::path dir = fresh_folder(name);
+  write(dir / "scene.json", R"({"needle": {)" + needle + R"(, "length_mm": 26, "mesh": {"order": 1, "size_mm": 0.5}},)"
+                            R"("motion": {"accel_time_ms": 0.02, "travel_mm": 0.8}, "cannula": {"enabled": false},)"
+                            R"("tissue": {"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4}, "solver": {"mass_scaling_dt_ms": 1e-5},)"
+                            R"("output": {"frames": 0, "history_interval_ms": 0.02}})");
+  const auto r = run("run --scene " + (dir / "scene.json").string() + " --out " + (dir / "run").string() + " --quiet " + flags, true);
+  INFO(r.out);
+  REQUIRE(r.exit_code == 0);
+  std::ifstream scene_file(dir / "run" / "scene.json"), summary_file(dir / "run" / "summary.json");
+  return RunFiles{nlohmann::json::parse(scene_file), nlohmann::json::parse(summary_file),
+                  needle::read_csv_table((dir / "run" / "history.csv").string())};
+}
+
 std::string message_of(const std::string& text) {
   try {
     needle::parse_scene(text, "scene.json");
@@ -465,23 +480,10 @@ TEST_CASE("needle run --relaxing-shear-fraction: the scene says so, the relaxed 
 
 TEST_CASE("needle run --cutting-pressure-mpa: the scene says so, the tip pays the cutting work, bad input is refused",
           "[apps][lspg][gmsh][cutting]") {
-  // A 26 mm SB pushed 0.8 mm into the small block with and without a cutting pressure of 0.2 MPa: the key is written only
+  // The SB pushed 0.8 mm into the small block with and without a cutting pressure of 0.2 MPa: the key is written only
   // when on; the work goes into the summary and into the balance (which must still close); the needle is held back harder.
-  auto run_sb = [](const std::string& name, const std::string& flags, const std::string& needle = R"("preset": "SB")") {
-    const fs::path dir = fresh_folder(name);
-    write(dir / "scene.json", R"({"needle": {)" + needle + R"(, "length_mm": 26, "mesh": {"order": 1, "size_mm": 0.5}},)"
-                              R"("motion": {"accel_time_ms": 0.02, "travel_mm": 0.8}, "cannula": {"enabled": false},)"
-                              R"("tissue": {"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4}, "solver": {"mass_scaling_dt_ms": 1e-5},)"
-                              R"("output": {"frames": 0, "history_interval_ms": 0.02}})");
-    const auto r = run("run --scene " + (dir / "scene.json").string() + " --out " + (dir / "run").string() + " --quiet " + flags, true);
-    INFO(r.out);
-    REQUIRE(r.exit_code == 0);
-    std::ifstream scene_file(dir / "run" / "scene.json"), summary_file(dir / "run" / "summary.json");
-    return RunFiles{nlohmann::json::parse(scene_file), nlohmann::json::parse(summary_file),
-                    needle::read_csv_table((dir / "run" / "history.csv").string())};
-  };
-  const RunFiles free_cut = run_sb("cutting_free", "");
-  const RunFiles paid_cut = run_sb("cutting_paid", "--cutting-pressure-mpa 0.2");
+  const RunFiles free_cut = run_sb_into_small_block("cutting_free", "");
+  const RunFiles paid_cut = run_sb_into_small_block("cutting_paid", "--cutting-pressure-mpa 0.2");
   CHECK_FALSE(free_cut.scene["tissue"]["contact"].contains("cutting_pressure_MPa"));
   CHECK(paid_cut.scene["tissue"]["contact"]["cutting_pressure_MPa"].get<double>() == 0.2);
   CHECK(free_cut.summary["cutting"]["work_mJ"].get<double>() == 0.0);
@@ -499,7 +501,7 @@ TEST_CASE("needle run --cutting-pressure-mpa: the scene says so, the tip pays th
     const fs::path recipe = fresh_folder("cutting_recipe") / "bevel.json";
     write(recipe, R"({"name": "one bevel", "groove": {"length_mm": 22.0, "remaining_thickness_mm": 0.43, "start_behind_tip_mm": 3.0},)"
                   R"("grinds": [{"name": "bevel", "tilt_deg": 23.5, "rotation_deg": 0, "depth_mm": 1.0}]})");
-    const RunFiles named = run_sb("cutting_named", "--cutting-pressure-mpa 0.2", R"("recipe": ")" + recipe.string() + R"(")");
+    const RunFiles named = run_sb_into_small_block("cutting_named", "--cutting-pressure-mpa 0.2", R"("recipe": ")" + recipe.string() + R"(")");
     CHECK(named.summary["cutting"]["work_mJ"].get<double>() > 0.5 * work_mJ);
   }
 
@@ -510,6 +512,37 @@ TEST_CASE("needle run --cutting-pressure-mpa: the scene says so, the tip pays th
     const auto bad = run_rod_into_block(dir, R"({"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4})", 0.8, 0, flags);
     INFO(flags << ": " << bad.out);
     CHECK(bad.exit_code == 2);
+    CHECK(bad.out.find(message) != std::string::npos);
+    CHECK(!fs::exists(dir / "run"));
+  }
+}
+
+TEST_CASE("needle run --crack-reach-mm: the scene says so, the tip's crack cuts bonds past the rod, bad input is refused",
+          "[apps][lspg][gmsh][crack]") {
+  // The SB pushed 0.8 mm in, with and without a horizontal crack 1 mm long from tip point A (at the rod's bottom, y = -0.5):
+  // the lattice's bonds from y = -0.8 to -0.4 cross its plane beside the rod, where the needle's body never is, so the
+  // needle alone cuts none of them. The key is written only when on, and the balance still closes.
+  const RunFiles uncracked = run_sb_into_small_block("crack_off", "");
+  const RunFiles cracked = run_sb_into_small_block("crack_on", "--crack-reach-mm 1.0 --crack-angles-deg 0");
+  CHECK_FALSE(uncracked.scene["tissue"]["contact"].contains("crack_reach_mm"));
+  CHECK(cracked.scene["tissue"]["contact"]["crack_reach_mm"].get<double>() == 1.0);
+  CHECK(cracked.scene["tissue"]["contact"]["crack_angles_deg"] == nlohmann::json::array({0.0}));
+  CHECK(uncracked.summary["crack"]["bonds_cut"].get<long>() == 0);
+  const long crack_cuts = cracked.summary["crack"]["bonds_cut"].get<long>();
+  INFO("bonds cut by the crack " << crack_cuts << ", by the needle " << cracked.summary["bonds_cut_by_needle"] << " (without the crack "
+                                 << uncracked.summary["bonds_cut_by_needle"] << "); balance " << cracked.summary["energy_balance_error"]);
+  CHECK(crack_cuts > 0);
+  CHECK(cracked.summary["bonds_broken"].get<long>() >= crack_cuts + cracked.summary["bonds_cut_by_needle"].get<long>());
+  CHECK(cracked.summary["status"] == "finished");
+  CHECK(cracked.summary["energy_balance_error"].get<double>() < 0.02);
+
+  for (const auto& [flags, message] : {std::pair<std::string, std::string>{"--crack-reach-mm -1", "--crack-reach-mm must be a number >= 0"},
+                                       {"--crack-reach-mm 1 --crack-angles-deg 0,200", "--crack-angles-deg must be angles from -180 to 180 degrees (got 0,200)"}}) {
+    const fs::path dir = fresh_folder("crack_bad");
+    const auto bad = run_rod_into_block(dir, R"({"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4})", 0.8, 0, flags);
+    INFO(flags << ": " << bad.out);
+    CHECK(bad.exit_code == 2);
+    CHECK(std::count(bad.out.begin(), bad.out.end(), '\n') == 1);
     CHECK(bad.out.find(message) != std::string::npos);
     CHECK(!fs::exists(dir / "run"));
   }
