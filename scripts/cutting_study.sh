@@ -51,20 +51,5 @@ for p in "${pressures[@]}"; do
 done
 mv "$csv.partial" "$csv"
 
-awk -F, 'NR > 1 { d[$1, $2] = $3; s[$1, $2] = $8; if (!($2 in seen)) { seen[$2] = 1; order[++m] = $2 } if (!($1 in known)) { known[$1] = 1; needle[++k] = $1 } }
-END {
-  printf "%-10s", "p_c (MPa)"
-  for (j = 1; j <= k; ++j) printf " %9s", needle[j]
-  for (j = 1; j <= k; ++j) if (needle[j] != "SB") printf " %9s", needle[j] "/SB"
-  printf "   (delta in mm at 10 mm)\n"
-  for (i = 1; i <= m; ++i) {
-    p = order[i]; bad = 0
-    printf "%-10s", p
-    for (j = 1; j <= k; ++j) { printf " %+9.3f", d[needle[j], p]; if (s[needle[j], p] != "finished") bad = 1 }
-    for (j = 1; j <= k; ++j) if (needle[j] != "SB") printf " %9.2f", d["SB", p] != 0 ? d[needle[j], p] / d["SB", p] : 0
-    if (bad) printf "   a run stopped: see its summary.json"
-    printf "\n"
-  }
-  printf "experiment at 30 mm: SB -1.14, LMB +0.15, AMB +0.24, HMB +1.71 (LMB/SB -0.13, AMB/SB -0.21, HMB/SB -1.50)\n"
-}' "$csv"
+ratio_table "$csv" "p_c (MPa)"
 echo "table: $csv; runs in $out/<needle>_p<p_c>"

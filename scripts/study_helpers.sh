@@ -24,3 +24,29 @@ summary_status() {
 summary_run_fields() {
   echo "$(summary_number steps "$1"),$(summary_number max_energy_balance_error "$1"),$(summary_number runtime_s "$1"),$(summary_status "$1")"
 }
+
+# ratio_table CSV LABEL: delta of each needle for each case, and the ratios to SB, from a study table whose columns are
+# needle,case,deflection_mm,... with the run's status in column 8 (the cutting and crack studies).
+ratio_table() {
+  awk -F, -v label="$2" 'NR > 1 { d[$1, $2] = $3; s[$1, $2] = $8; if (!($2 in seen)) { seen[$2] = 1; order[++m] = $2 } if (!($1 in known)) { known[$1] = 1; needle[++k] = $1 } }
+  END {
+    printf "%-10s", label
+    for (j = 1; j <= k; ++j) printf " %9s", needle[j]
+    for (j = 1; j <= k; ++j) if (needle[j] != "SB") printf " %9s", needle[j] "/SB"
+    printf "   (delta in mm at 10 mm)\n"
+    for (i = 1; i <= m; ++i) {
+      p = order[i]; bad = 0
+      printf "%-10s", p
+      for (j = 1; j <= k; ++j) {
+        if (!((needle[j], p) in d)) { printf " %9s", "-"; continue }  # not run for this case
+        printf " %+9.3f", d[needle[j], p]; if (s[needle[j], p] != "finished") bad = 1
+      }
+      for (j = 1; j <= k; ++j) if (needle[j] != "SB") {
+        if (((needle[j], p) in d) && d["SB", p] != 0) printf " %9.2f", d[needle[j], p] / d["SB", p]; else printf " %9s", "-"
+      }
+      if (bad) printf "   a run stopped: see its summary.json"
+      printf "\n"
+    }
+    printf "experiment at 30 mm: SB -1.14, LMB +0.15, AMB +0.24, HMB +1.71 (LMB/SB -0.13, AMB/SB -0.21, HMB/SB -1.50)\n"
+  }' "$1"
+}

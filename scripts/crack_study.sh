@@ -1,0 +1,58 @@
+#!/usr/bin/env bash
+# Does a crack past the rod's outline move the balance of the tips' loads? The needle's cut separates the gel only along
+# the rod's own surface, so for a tip point above the rod's bottom (LMB, AMB, HMB) the tissue below it stays bonded to the
+# tissue beside the rod and presses the whole shaft up. --crack-reach-mm R cuts the bonds across fins that leave tip point A
+# (docs/insertion.md; by default one horizontal fin at A's height), so the gel splits at A past the rod, as the paper's
+# "tissue separation point" says. Runs the needles 10 mm into data/scenes/spacing_study_10mm.json (0.2 mm particles near the
+# path, the card at E 0.0748 MPa) for each reach and prints delta and the ratios to SB (docs/paper.md).
+#
+#   scripts/crack_study.sh [OUT] [REACH_mm...]
+#       default: out/crack, reaches 1 2
+#   NEEDLES="SB LMB AMB HMB" ANGLES="48.6,-55" scripts/crack_study.sh ...   (default NEEDLES="SB AMB", ANGLES="0"; SB must be among them)
+#
+# Two runs at once (one core each). A finished run (OUT/<needle>_r<reach>[_a<angles>]/summary.json) is kept, so an
+# interrupted study resumes. About 7 min a run with two at once (19 683 particles).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+out="${1:-out/crack}"
+shift || true
+[ -x build/apps/needle ] || bash scripts/build.sh
+mkdir -p "$out"
+
+reaches=("$@")
+[ "${#reaches[@]}" -gt 0 ] || reaches=(1 2)
+for r in "${reaches[@]}"; do
+  [[ "$r" =~ ^[0-9]*\.?[0-9]+$ ]] && [[ ! "$r" =~ ^0*\.?0*$ ]] || { echo "crack_study: '$r' is not a reach in mm (a number > 0, e.g. 1)" >&2; exit 2; }
+done
+angles="${ANGLES:-0}"
+[[ "$angles" =~ ^-?[0-9.]+(,-?[0-9.]+)*$ ]] || { echo "crack_study: ANGLES='$angles' is not a comma-separated list of degrees (e.g. 0 or 48.6,-55)" >&2; exit 2; }
+suffix=""
+[ "$angles" = "0" ] || suffix="_a${angles//,/_}"
+read -r -a needles <<< "${NEEDLES:-SB AMB}"
+[[ " ${needles[*]} " == *" SB "* ]] || { echo "crack_study: NEEDLES must include SB (the ratios are to SB)" >&2; exit 2; }
+
+# shellcheck source=scripts/study_helpers.sh
+source scripts/study_helpers.sh
+
+csv="$out/crack_study$suffix.csv"
+echo "needle,crack_reach_mm,deflection_mm,bonds_cut_by_crack,coupling_steps,max_energy_balance_error,runtime_s,status" > "$csv.partial"
+for r in "${reaches[@]}"; do
+  flags=(--path-refinement 2 --crack-reach-mm "$r" --crack-angles-deg "$angles")
+  for ((i = 0; i < ${#needles[@]}; i += 2)); do
+    { study_run crack_study "$out/${needles[i]}_r$r$suffix" "${needles[i]}" "${flags[@]}" & }
+    if [ $((i + 1)) -lt ${#needles[@]} ]; then
+      { study_run crack_study "$out/${needles[i + 1]}_r$r$suffix" "${needles[i + 1]}" "${flags[@]}" & }
+    fi
+    wait
+  done
+  for needle in "${needles[@]}"; do
+    s="$out/${needle}_r$r$suffix/summary.json"
+    [ -f "$s" ] || { echo "crack_study: no summary in $out/${needle}_r$r$suffix" >&2; exit 1; }
+    echo "$needle,$r,$(summary_number deflection_mm "$s"),$(summary_number bonds_cut "$s"),$(summary_run_fields "$s")" >> "$csv.partial"
+  done
+done
+mv "$csv.partial" "$csv"
+
+ratio_table "$csv" "reach (mm)"
+echo "without a crack (docs/paper_results/spacing_study_10mm.csv): SB -0.212, LMB +0.045, AMB +0.355, HMB +0.647 mm"
+echo "table: $csv; runs in $out/<needle>_r<reach>$suffix"
