@@ -185,6 +185,8 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
   contact.cutting_facets = built.tip_facets;
   NEEDLE_REQUIRE(contact.cutting_pressure_MPa == 0 || !contact.cutting_facets.empty(),
                  "a cutting pressure needs a needle with tip facets: a ground tip from a preset, d_a or a recipe (not a plain rod or a mesh file)");
+  NEEDLE_REQUIRE(!contact.crack.enabled() || !contact.cutting_facets.empty(),
+                 "a crack from the tip point needs a needle with a ground tip point: a preset, d_a or a recipe (not a plain rod or a mesh file)");
   const double setup_s = std::chrono::duration<double>(Clock::now() - start).count();
 
   RunFolder folder(o.out_dir, o.overwrite);

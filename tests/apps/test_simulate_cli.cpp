@@ -536,8 +536,10 @@ TEST_CASE("needle run --crack-reach-mm: the scene says so, the tip's crack cuts 
   CHECK(cracked.summary["status"] == "finished");
   CHECK(cracked.summary["energy_balance_error"].get<double>() < 0.02);
 
+  // A negative reach, an angle out of range, and a needle without a tip point (the plain rod): one line, exit 2, no run folder.
   for (const auto& [flags, message] : {std::pair<std::string, std::string>{"--crack-reach-mm -1", "--crack-reach-mm must be a number >= 0"},
-                                       {"--crack-reach-mm 1 --crack-angles-deg 0,200", "--crack-angles-deg must be angles from -180 to 180 degrees (got 0,200)"}}) {
+                                       {"--crack-reach-mm 1 --crack-angles-deg 0,200", "--crack-angles-deg must be angles from -180 to 180 degrees (got 0,200)"},
+                                       {"--crack-reach-mm 1", "a crack from the tip point needs a needle with a ground tip point"}}) {
     const fs::path dir = fresh_folder("crack_bad");
     const auto bad = run_rod_into_block(dir, R"({"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4})", 0.8, 0, flags);
     INFO(flags << ": " << bad.out);
