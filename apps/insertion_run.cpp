@@ -279,7 +279,7 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
       {"bond_cut_s", run.bond_cut_s()},
       {"slit", {{"particles_opened", run.particles_opened_by_slit()}, {"max_opening_mm", slit_opening.max_mm},
                 {"mean_opening_mm", slit_opening.mean_mm}}},
-      {"crack", {{"reach_mm", scene.tissue.contact.crack.reach_mm}, {"bonds_cut", run.bonds_cut_by_crack()}}},
+      {"crack", {{"reach_mm", scene.tissue.contact.crack.reach_mm}, {"bonds_cut", run.bonds_cut_by_crack()}, {"crack_s", run.crack_s()}}},
       {"cutting", {{"pressure_MPa", scene.tissue.contact.cutting_pressure_MPa}, {"work_mJ", run.contact_model().cutting_work_mJ()},
                    {"force_at_end_N", run.contact().cutting_force_N}}},
       {"groove",

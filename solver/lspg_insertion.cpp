@@ -122,8 +122,11 @@ void LspgInsertion::step(double end_time_ms) {
     bond_cut_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
   slit_.open(tissue_.particles(), needle_.positions_mm());
-  if (crack_.options().enabled())
+  if (crack_.options().enabled()) {
+    const auto start = std::chrono::steady_clock::now();
     bonds_cut_by_crack_ += tissue_.cut_bonds(crack_.bonds_across(tissue_.bonds(), tissue_.particles().position_mm, needle_.positions_mm()));
+    crack_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
   ++steps_;
   last_dt_ms_ = dt;
   update_energy();

@@ -85,6 +85,7 @@ class LspgInsertion {
   long bonds_cut_by_needle() const { return static_cast<long>(tissue_.bonds().cut_count - bonds_cut_by_crack_); }
   std::int64_t particles_opened_by_slit() const { return slit_.opened(); }
   std::int64_t bonds_cut_by_crack() const { return bonds_cut_by_crack_; }
+  double crack_s() const { return crack_s_; }  // wall time spent finding the bonds across the crack's fins
   double bond_cut_s() const { return bond_cut_s_; }  // wall time spent finding the bonds the needle cuts
   // Momenta (g mm/ms) and what the drive put in.
   Eigen::Vector3d tissue_momentum() const;
@@ -105,6 +106,7 @@ class LspgInsertion {
   SymmetrySlit slit_;
   TipCrack crack_;
   std::int64_t bonds_cut_by_crack_ = 0;
+  double crack_s_ = 0;
   double bond_cut_s_ = 0;
   InsertionEnergy energy_;
   bool in_step_ = false;

@@ -532,6 +532,8 @@ TEST_CASE("needle run --crack-reach-mm: the scene says so, the tip's crack cuts 
   INFO("bonds cut by the crack " << crack_cuts << ", by the needle " << cracked.summary["bonds_cut_by_needle"] << " (without the crack "
                                  << uncracked.summary["bonds_cut_by_needle"] << "); balance " << cracked.summary["energy_balance_error"]);
   CHECK(crack_cuts > 0);
+  CHECK(cracked.summary["crack"]["crack_s"].get<double>() > 0);
+  CHECK(uncracked.summary["crack"]["crack_s"].get<double>() == 0.0);
   CHECK(cracked.summary["bonds_broken"].get<long>() >= crack_cuts + cracked.summary["bonds_cut_by_needle"].get<long>());
   CHECK(cracked.summary["status"] == "finished");
   CHECK(cracked.summary["energy_balance_error"].get<double>() < 0.02);
