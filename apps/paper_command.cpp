@@ -104,6 +104,33 @@ void paper(const PaperOptions& o) {
       }
     }
   }
+  if (o.report_only) {
+    // The report describes the runs in the folder: their E, whatever the defaults say. A flag that names another
+    // E than the runs used would put a wrong number beside their results.
+    double runs_E_MPa = std::nan("");
+    std::string first;
+    for (const std::string& name : needles) {
+      const fs::path scene_path = dir / "runs" / name / "scene.json";
+      if (!fs::is_regular_file(scene_path)) continue;  // the report names the missing run
+      const double E = number_or_nan(read_json_file(scene_path.string(), "run scene").value("tissue", json::object()).value("material", json::object()),
+                                     "E_MPa");
+      if (std::isnan(E)) continue;
+      if (first.empty()) {
+        runs_E_MPa = E;
+        first = name;
+      }
+      NEEDLE_REQUIRE(E == runs_E_MPa, fmt::format("the runs in '{}' disagree on the tissue's E: {} {} MPa, {} {} MPa",
+                                                  (dir / "runs").string(), first, runs_E_MPa, name, E));
+    }
+    if (!std::isnan(runs_E_MPa)) {
+      const bool E_given = !o.calibration_file.empty() || !std::isnan(o.tissue_E_MPa);
+      NEEDLE_REQUIRE(!E_given || std::abs(scene.tissue.material.E_MPa - runs_E_MPa) <= 1e-12 * runs_E_MPa,
+                     fmt::format("the runs in '{}' used E = {} MPa, not the {} MPa that {} gives", (dir / "runs").string(), runs_E_MPa,
+                                 scene.tissue.material.E_MPa, o.calibration_file.empty() ? "--tissue-E-MPa" : o.calibration_file));
+      if (!E_given) E_source = fmt::format("read from the runs' scene.json");
+      scene.tissue.material.E_MPa = runs_E_MPa;
+    }
+  }
   PaperReportInput report;
   report.out_dir = o.out_dir;
   report.needles = needles;

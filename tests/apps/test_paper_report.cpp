@@ -172,6 +172,39 @@ TEST_CASE("needle paper --report-only names the tissue law, the relaxation, the 
   CHECK(tissue.find("driven at 4 m/s") != std::string::npos);
 }
 
+TEST_CASE("needle paper --report-only takes E from the runs it reports, and refuses a flag that names another", "[apps][paper]") {
+  // Runs made at E 0.0748 MPa (e.g. with --tissue-E-MPa): the report must say their E, not the card's default.
+  auto write_runs_at = [](const fs::path& dir, double lmb_E_MPa) {
+    for (const char* name : {"SB", "LMB", "AMB", "HMB"}) {
+      write_run(dir, name, {-1.1, 0.9});
+      json scene = read_json(dir / "runs" / name / "scene.json");
+      scene["tissue"]["material"] = {{"E_MPa", std::string(name) == "LMB" ? lmb_E_MPa : 0.0748}};
+      std::ofstream(dir / "runs" / name / "scene.json") << scene.dump(2);
+    }
+  };
+  const fs::path dir = fresh("runs_E");
+  write_runs_at(dir, 0.0748);
+  const auto result = run("paper --report-only --no-tips --quiet --out " + dir.string(), true);
+  INFO(result.out);
+  REQUIRE(result.exit_code == 0);
+  CHECK(read_json(dir / "results.json")["tissue_E_MPa"].get<double>() == 0.0748);
+  CHECK(read_text(dir / "report.md").find("Tissue E = 0.0748 MPa (read from the runs' scene.json)") != std::string::npos);
+
+  const fs::path given = fresh("runs_E_given");
+  write_runs_at(given, 0.0748);
+  auto bad = run("paper --report-only --no-tips --quiet --tissue-E-MPa 0.05 --out " + given.string(), true);
+  CHECK(bad.exit_code == 2);
+  CHECK(bad.out.find("used E = 0.0748 MPa, not the 0.05 MPa that --tissue-E-MPa gives") != std::string::npos);
+  CHECK(!fs::exists(given / "report.md"));
+
+  const fs::path mixed = fresh("runs_E_mixed");
+  write_runs_at(mixed, 0.06);
+  bad = run("paper --report-only --no-tips --quiet --out " + mixed.string(), true);
+  CHECK(bad.exit_code == 2);
+  CHECK(bad.out.find("disagree on the tissue's E: SB 0.0748 MPa, LMB 0.06 MPa") != std::string::npos);
+  CHECK(!fs::exists(mixed / "report.md"));
+}
+
 TEST_CASE("needle paper refuses missing runs and unknown needles with one message and exit 2", "[apps][paper]") {
   const fs::path dir = fresh("bad");
   auto r = run("paper --report-only --no-tips --out " + dir.string(), true);
