@@ -38,16 +38,9 @@ csv="$out/crack_study$suffix.csv"
 echo "needle,crack_reach_mm,deflection_mm,bonds_cut_by_crack,coupling_steps,max_energy_balance_error,runtime_s,status" > "$csv.partial"
 for r in "${reaches[@]}"; do
   flags=(--path-refinement 2 --crack-reach-mm "$r" --crack-angles-deg "$angles")
-  for ((i = 0; i < ${#needles[@]}; i += 2)); do
-    { study_run crack_study "$out/${needles[i]}_r$r$suffix" "${needles[i]}" "${flags[@]}" & }
-    if [ $((i + 1)) -lt ${#needles[@]} ]; then
-      { study_run crack_study "$out/${needles[i + 1]}_r$r$suffix" "${needles[i + 1]}" "${flags[@]}" & }
-    fi
-    wait
-  done
+  study_run_two_at_once crack_study "$out" "_r$r$suffix" "${needles[*]}" "${flags[@]}"
   for needle in "${needles[@]}"; do
-    s="$out/${needle}_r$r$suffix/summary.json"
-    [ -f "$s" ] || { echo "crack_study: no summary in $out/${needle}_r$r$suffix" >&2; exit 1; }
+    s=$(study_summary crack_study "$out/${needle}_r$r$suffix")
     echo "$needle,$r,$(summary_number deflection_mm "$s"),$(summary_number bonds_cut "$s"),$(summary_run_fields "$s")" >> "$csv.partial"
   done
 done

@@ -36,16 +36,9 @@ echo "needle,cutting_pressure_MPa,deflection_mm,cutting_work_mJ,coupling_steps,m
 for p in "${pressures[@]}"; do
   flags=()
   [[ "$p" =~ ^0*\.?0*$ ]] || flags=(--cutting-pressure-mpa "$p")
-  for ((i = 0; i < ${#needles[@]}; i += 2)); do
-    { study_run cutting_study "$out/${needles[i]}_p$p" "${needles[i]}" --path-refinement 2 "${flags[@]}" & }
-    if [ $((i + 1)) -lt ${#needles[@]} ]; then
-      { study_run cutting_study "$out/${needles[i + 1]}_p$p" "${needles[i + 1]}" --path-refinement 2 "${flags[@]}" & }
-    fi
-    wait
-  done
+  study_run_two_at_once cutting_study "$out" "_p$p" "${needles[*]}" --path-refinement 2 "${flags[@]}"
   for needle in "${needles[@]}"; do
-    s="$out/${needle}_p$p/summary.json"
-    [ -f "$s" ] || { echo "cutting_study: no summary in $out/${needle}_p$p" >&2; exit 1; }
+    s=$(study_summary cutting_study "$out/${needle}_p$p")
     echo "$needle,$p,$(summary_number deflection_mm "$s"),$(summary_number work_mJ "$s"),$(summary_run_fields "$s")" >> "$csv.partial"
   done
 done

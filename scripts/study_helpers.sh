@@ -1,4 +1,4 @@
-# Sourced by the 10 mm study scripts (spacing, dynamics, domain): run one case, read fields of its summary.json without a JSON tool.
+# Sourced by the 10 mm study scripts (scripts/*_study.sh): run cases, read fields of their summary.json without a JSON tool, print ratio tables.
 
 # study_run STUDY RUN NEEDLE [FLAG...]: NEEDLE 10 mm into data/scenes/spacing_study_10mm.json with the FLAGs, into the folder RUN,
 # unless RUN already holds a run (so an interrupted study resumes). A run the solver stopped is kept and reported with its status;
@@ -10,6 +10,28 @@ study_run() {
     ./build/apps/needle run --scene data/scenes/spacing_study_10mm.json --preset "$needle" "$@" --out "$run" --overwrite || true
   fi
   [ -f "$run/summary.json" ] || { echo "$study: no summary in $run" >&2; exit 1; }
+}
+
+# study_run_two_at_once STUDY OUT CASE "NEEDLE..." [FLAG...]: study_run for each NEEDLE into OUT/<NEEDLE>CASE, two at once
+# (one core each).
+study_run_two_at_once() {
+  local study="$1" out="$2" case="$3" i
+  local -a names
+  read -r -a names <<< "$4"
+  shift 4
+  for ((i = 0; i < ${#names[@]}; i += 2)); do
+    { study_run "$study" "$out/${names[i]}$case" "${names[i]}" "$@" & }
+    if [ $((i + 1)) -lt ${#names[@]} ]; then
+      { study_run "$study" "$out/${names[i + 1]}$case" "${names[i + 1]}" "$@" & }
+    fi
+    wait
+  done
+}
+
+# study_summary STUDY RUN: RUN's summary.json, or a message and failure when there is none.
+study_summary() {
+  [ -f "$2/summary.json" ] || { echo "$1: no summary in $2" >&2; return 1; }
+  echo "$2/summary.json"
 }
 
 # summary_number KEY FILE: the first numeric value of "KEY":
