@@ -56,6 +56,17 @@ RunFiles run_rod_into_small_block(const std::string& name, const std::string& fl
           needle::read_csv_table((dir / "run" / "history.csv").string())};
 }
 
+// The plain rod into the small block with flags the run must refuse: exit 2, the message, no run folder. Returns the output.
+std::string refused_on_small_block(const std::string& name, const std::string& flags, const std::string& message) {
+  const fs::path dir = fresh_folder(name);
+  const auto bad = run_rod_into_block(dir, R"({"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4})", 0.8, 0, flags);
+  INFO(flags << ": " << bad.out);
+  CHECK(bad.exit_code == 2);
+  CHECK(bad.out.find(message) != std::string::npos);
+  CHECK(!fs::exists(dir / "run"));
+  return bad.out;
+}
+
 // A 26 mm SB (T4 0.5 mm, no cannula) pushed 0.8 mm into the small block.
 RunFiles run_sb_into_small_block(const std::string& name, const std::string& flags, const std::string& needle = R"("preset": "SB")") {
   const fs::path dir = fresh_folder(name);
@@ -394,11 +405,7 @@ TEST_CASE("needle run --tissue-size-mm: the lattice fills the given block, and f
   CHECK(wide.internal_mJ < narrow.internal_mJ);
   CHECK(wide.drag_N < narrow.drag_N);
 
-  const fs::path dir = fresh_folder("size_bad");
-  const auto bad = run_rod_into_block(dir, R"({"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4})", 0.8, 0, "--tissue-size-mm 2,0,1.2");
-  CHECK(bad.exit_code == 2);
-  CHECK(bad.out.find("--tissue-size-mm must be three positive lengths x,y,z (got 2,0,1.2)") != std::string::npos);
-  CHECK(!fs::exists(dir / "run"));
+  refused_on_small_block("size_bad", "--tissue-size-mm 2,0,1.2", "--tissue-size-mm must be three positive lengths x,y,z (got 2,0,1.2)");
 }
 
 TEST_CASE("needle run --slit-half-height-mm: the symmetry plane opens behind the tip, and its particles leave the plane",
@@ -419,12 +426,8 @@ TEST_CASE("needle run --slit-half-height-mm: the symmetry plane opens behind the
   CHECK(open.summary["status"] == "finished");
   CHECK(open.summary["max_energy_balance_error"].get<double>() < 0.05);
 
-  const fs::path dir = fresh_folder("slit_bad");
-  const auto bad = run_rod_into_block(dir, R"({"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4})", 0.8, 0, "--slit-half-height-mm -1");
-  CHECK(bad.exit_code == 2);
-  CHECK(std::count(bad.out.begin(), bad.out.end(), '\n') == 1);
-  CHECK(bad.out.find("--slit-half-height-mm must be a number >= 0 (got -1)") != std::string::npos);
-  CHECK(!fs::exists(dir / "run"));
+  const std::string out = refused_on_small_block("slit_bad", "--slit-half-height-mm -1", "--slit-half-height-mm must be a number >= 0 (got -1)");
+  CHECK(std::count(out.begin(), out.end(), '\n') == 1);
 }
 
 TEST_CASE("needle run --decel-time-ms: a ramped stop leaves the needle far less ringing than an instantaneous one", "[apps][lspg][gmsh]") {
@@ -469,12 +472,7 @@ TEST_CASE("needle run --relaxing-shear-fraction: the scene says so, the relaxed 
   for (const auto& [flags, message] : {std::pair<std::string, std::string>{"--relaxing-shear-fraction 1", "relaxing_shear_fraction must lie in [0, 1)"},
                                        {"--relaxation-time-ms 0.5", "--relaxation-time-ms needs --relaxing-shear-fraction"},
                                        {"--relaxing-shear-fraction 0.5 --relaxation-time-ms -1", "relaxation_time_ms must be positive"}}) {
-    const fs::path dir = fresh_folder("relax_bad");
-    const auto bad = run_rod_into_block(dir, R"({"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4})", 0.8, 0, flags);
-    INFO(flags << ": " << bad.out);
-    CHECK(bad.exit_code == 2);
-    CHECK(bad.out.find(message) != std::string::npos);
-    CHECK(!fs::exists(dir / "run"));
+    refused_on_small_block("relax_bad", flags, message);
   }
 }
 
@@ -508,12 +506,7 @@ TEST_CASE("needle run --cutting-pressure-mpa: the scene says so, the tip pays th
   // A negative pressure, and a needle without tip facets to load (the plain rod): one line, exit 2, no run folder.
   for (const auto& [flags, message] : {std::pair<std::string, std::string>{"--cutting-pressure-mpa -1", "--cutting-pressure-mpa must be a number >= 0"},
                                        {"--cutting-pressure-mpa 0.2", "a cutting pressure needs a needle with tip facets"}}) {
-    const fs::path dir = fresh_folder("cutting_bad");
-    const auto bad = run_rod_into_block(dir, R"({"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4})", 0.8, 0, flags);
-    INFO(flags << ": " << bad.out);
-    CHECK(bad.exit_code == 2);
-    CHECK(bad.out.find(message) != std::string::npos);
-    CHECK(!fs::exists(dir / "run"));
+    refused_on_small_block("cutting_bad", flags, message);
   }
 }
 
@@ -542,12 +535,8 @@ TEST_CASE("needle run --crack-reach-mm: the scene says so, the tip's crack cuts 
   for (const auto& [flags, message] : {std::pair<std::string, std::string>{"--crack-reach-mm -1", "--crack-reach-mm must be a number >= 0"},
                                        {"--crack-reach-mm 1 --crack-angles-deg 0,200", "--crack-angles-deg must be angles from -180 to 180 degrees (got 0,200)"},
                                        {"--crack-reach-mm 1", "a crack from the tip point needs a needle with a ground tip point"}}) {
-    const fs::path dir = fresh_folder("crack_bad");
-    const auto bad = run_rod_into_block(dir, R"({"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4})", 0.8, 0, flags);
-    INFO(flags << ": " << bad.out);
-    CHECK(bad.exit_code == 2);
-    CHECK(std::count(bad.out.begin(), bad.out.end(), '\n') == 1);
-    CHECK(bad.out.find(message) != std::string::npos);
-    CHECK(!fs::exists(dir / "run"));
+    const std::string out = refused_on_small_block("crack_bad", flags, message);
+    INFO(flags << ": " << out);
+    CHECK(std::count(out.begin(), out.end(), '\n') == 1);
   }
 }
