@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "solver/parallel.h"
 #include "solver/rk_shape_functions.h"
 
 namespace needle {
@@ -23,5 +24,22 @@ struct BondNetwork {
 };
 
 BondNetwork build_bond_network(const RkShapeFunctions& rk);
+
+// The intact bonds for which selected(bond) holds, in increasing order; tested in parallel (selected must only read).
+template <class Selected>
+std::vector<std::int64_t> select_intact_bonds(const BondNetwork& bonds, const Selected& selected) {
+  const std::int64_t n = static_cast<std::int64_t>(bonds.bonds.size());
+  std::vector<std::uint8_t> chosen(static_cast<size_t>(n), 0);
+  parallel_for(n, [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t b = begin; b < end; ++b) {
+      const Bond& bond = bonds.bonds[static_cast<size_t>(b)];
+      chosen[static_cast<size_t>(b)] = !bond.broken && selected(bond);
+    }
+  });
+  std::vector<std::int64_t> out;
+  for (std::int64_t b = 0; b < n; ++b)
+    if (chosen[static_cast<size_t>(b)]) out.push_back(b);
+  return out;
+}
 
 }  // namespace needle

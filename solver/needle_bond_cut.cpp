@@ -4,7 +4,6 @@
 #include <array>
 #include <cmath>
 
-#include "solver/parallel.h"
 
 namespace needle {
 
@@ -129,19 +128,9 @@ std::vector<double> NeedleBondCut::surface_crossings(const Eigen::Vector3d& a, c
 std::vector<std::int64_t> NeedleBondCut::bonds_through_needle(const BondNetwork& bonds, const std::vector<Vec3d>& x,
                                                               const Eigen::MatrixX3d& needle_x) const {
   const Grid grid = build_grid(needle_x);
-  const std::int64_t n = static_cast<std::int64_t>(bonds.bonds.size());
-  std::vector<std::uint8_t> through(static_cast<size_t>(n), 0);
-  parallel_for(n, [&](std::int64_t begin, std::int64_t end) {
-    for (std::int64_t b = begin; b < end; ++b) {
-      const Bond& bond = bonds.bonds[static_cast<size_t>(b)];
-      if (bond.broken) continue;
-      through[static_cast<size_t>(b)] = crossings(grid, x[static_cast<size_t>(bond.i)], x[static_cast<size_t>(bond.j)]).size() >= 2;
-    }
+  return select_intact_bonds(bonds, [&](const Bond& bond) {
+    return crossings(grid, x[static_cast<size_t>(bond.i)], x[static_cast<size_t>(bond.j)]).size() >= 2;
   });
-  std::vector<std::int64_t> out;
-  for (std::int64_t b = 0; b < n; ++b)
-    if (through[static_cast<size_t>(b)]) out.push_back(b);
-  return out;
 }
 
 }  // namespace needle

@@ -4,7 +4,6 @@
 #include <fmt/format.h>
 
 #include "geometry/input_error.h"
-#include "solver/parallel.h"
 
 namespace needle {
 
@@ -26,8 +25,7 @@ TipCrack::TipCrack(const Eigen::MatrixX3d& needle_reference_mm, const TipCrackOp
 
 std::vector<std::int64_t> TipCrack::bonds_across(const BondNetwork& bonds, const std::vector<Vec3d>& x,
                                                  const Eigen::MatrixX3d& needle_x) const {
-  std::vector<std::int64_t> out;
-  if (!options_.enabled()) return out;
+  if (!options_.enabled()) return {};
   const Eigen::Vector3d tip = needle_x.row(tip_node_).transpose();
   const double x_lo = tip.x() - kWindowBehindMm, x_hi = tip.x() + options_.lead_mm;
   struct Fin {
@@ -39,31 +37,20 @@ std::vector<std::int64_t> TipCrack::bonds_across(const BondNetwork& bonds, const
     const Eigen::Vector3d u(0, std::sin(psi), std::cos(psi));
     fins.push_back({u, Eigen::Vector3d::UnitX().cross(u)});
   }
-  const std::int64_t n = static_cast<std::int64_t>(bonds.bonds.size());
-  std::vector<std::uint8_t> across(static_cast<size_t>(n), 0);
-  parallel_for(n, [&](std::int64_t begin, std::int64_t end) {
-    for (std::int64_t b = begin; b < end; ++b) {
-      const Bond& bond = bonds.bonds[static_cast<size_t>(b)];
-      if (bond.broken) continue;
-      const Vec3d& p = x[static_cast<size_t>(bond.i)];
-      const Vec3d& q = x[static_cast<size_t>(bond.j)];
-      if (std::max(p.x(), q.x()) < x_lo || std::min(p.x(), q.x()) > x_hi) continue;
-      const Eigen::Vector3d a = p - tip, d = q - p;
-      for (const Fin& fin : fins) {
-        const double da = fin.normal.dot(a), db = fin.normal.dot(a + d);
-        if (!(da * db < 0)) continue;  // both ends on one side of the fin's plane, or one on it
-        const Eigen::Vector3d hit = a + (da / (da - db)) * d;  // relative to A
-        const double r = fin.along.dot(hit);
-        if (r >= 0 && r <= options_.reach_mm && tip.x() + hit.x() >= x_lo && tip.x() + hit.x() <= x_hi) {
-          across[static_cast<size_t>(b)] = 1;
-          break;
-        }
-      }
+  return select_intact_bonds(bonds, [&](const Bond& bond) {
+    const Vec3d& p = x[static_cast<size_t>(bond.i)];
+    const Vec3d& q = x[static_cast<size_t>(bond.j)];
+    if (std::max(p.x(), q.x()) < x_lo || std::min(p.x(), q.x()) > x_hi) return false;
+    const Eigen::Vector3d a = p - tip, d = q - p;
+    for (const Fin& fin : fins) {
+      const double da = fin.normal.dot(a), db = fin.normal.dot(a + d);
+      if (!(da * db < 0)) continue;  // both ends on one side of the fin's plane, or one on it
+      const Eigen::Vector3d hit = a + (da / (da - db)) * d;  // relative to A
+      const double r = fin.along.dot(hit);
+      if (r >= 0 && r <= options_.reach_mm && tip.x() + hit.x() >= x_lo && tip.x() + hit.x() <= x_hi) return true;
     }
+    return false;
   });
-  for (std::int64_t b = 0; b < n; ++b)
-    if (across[static_cast<size_t>(b)]) out.push_back(b);
-  return out;
 }
 
 }  // namespace needle
