@@ -183,9 +183,10 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
   SpgTissue tissue(particles, scene.tissue.material, scene.tissue.spg);
   ContactOptions contact = scene.tissue.contact;
   contact.cutting_facets = built.tip_facets;
-  NEEDLE_REQUIRE(contact.cutting_pressure_MPa == 0 || !contact.cutting_facets.empty(),
+  const bool ground_tip = !built.tip_facets.empty();  // a plain rod's end is cut square; a mesh file names no facets
+  NEEDLE_REQUIRE(contact.cutting_pressure_MPa == 0 || ground_tip,
                  "a cutting pressure needs a needle with tip facets: a ground tip from a preset, d_a or a recipe (not a plain rod or a mesh file)");
-  NEEDLE_REQUIRE(!contact.crack.enabled() || !contact.cutting_facets.empty(),
+  NEEDLE_REQUIRE(!contact.crack.enabled() || ground_tip,
                  "a crack from the tip point needs a needle with a ground tip point: a preset, d_a or a recipe (not a plain rod or a mesh file)");
   const double setup_s = std::chrono::duration<double>(Clock::now() - start).count();
 
