@@ -388,6 +388,11 @@ void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
                    fmt::format("--crack-angles-deg must be angles from -180 to 180 degrees (got {})", fmt::join(o.crack_angles_deg, ",")));
     scene.tissue.contact.crack.angles_deg = o.crack_angles_deg;
   }
+  if (given_or_zero(o.crack_lead_mm, "--crack-lead-mm")) scene.tissue.contact.crack.lead_mm = o.crack_lead_mm;
+  // The crack's shape without a crack would be dropped from scene.json without a word.
+  NEEDLE_REQUIRE((o.crack_angles_deg.empty() && std::isnan(o.crack_lead_mm)) || scene.tissue.contact.crack.enabled(),
+                 "--crack-angles-deg and --crack-lead-mm shape the tip's crack: they need --crack-reach-mm above 0 (or a scene with "
+                 "tissue.contact.crack_reach_mm)");
 }
 
 void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
@@ -439,6 +444,9 @@ void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
                 "The crack's fins, as directions in the cross-section from A: 0 toward +z (a horizontal crack at A's height), "
                 "90 up, -90 down, e.g. 0 or 48,-55 (default 0; scene key tissue.contact.crack_angles_deg)")
       ->delimiter(',');
+  c->add_option("--crack-lead-mm", o.crack_lead_mm,
+                "The crack's front runs this far ahead of tip point A, so the gel splits before the tip reaches it (default 0: "
+                "it opens as the tip passes; scene key tissue.contact.crack_lead_mm)");
 }
 
 std::string scene_override_arguments(const SceneOverrides& o) {
@@ -461,6 +469,7 @@ std::string scene_override_arguments(const SceneOverrides& o) {
   if (!std::isnan(o.cutting_pressure_MPa)) line += fmt::format(" --cutting-pressure-mpa {}", o.cutting_pressure_MPa);
   if (!std::isnan(o.crack_reach_mm)) line += fmt::format(" --crack-reach-mm {}", o.crack_reach_mm);
   if (!o.crack_angles_deg.empty()) line += fmt::format(" --crack-angles-deg {}", fmt::join(o.crack_angles_deg, ","));
+  if (!std::isnan(o.crack_lead_mm)) line += fmt::format(" --crack-lead-mm {}", o.crack_lead_mm);
   return line;
 }
 

@@ -107,6 +107,8 @@ NeedleRun read_run(const std::string& out_dir, const std::string& name) {
         r.model_description += fmt::format("; the tip drives a crack past the rod: fins from the tip point at {} deg in the cross-section "
                                            "(0: horizontal), {:g} mm long",
                                            fmt::join(angles, ", "), crack_mm);
+        const double lead_mm = contact.value("crack_lead_mm", 0.0);
+        if (lead_mm > 0) r.model_description += fmt::format(", running {:g} mm ahead of the tip", lead_mm);
       }
       // No cutting resistance is the default and goes unnamed; a resistance is said.
       const double cutting_MPa = contact.value("cutting_pressure_MPa", 0.0);

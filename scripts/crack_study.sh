@@ -9,6 +9,8 @@
 #   scripts/crack_study.sh [OUT] [REACH_mm...]
 #       default: out/crack, reaches 1 2
 #   NEEDLES="SB LMB AMB HMB" ANGLES="48.6,-55" scripts/crack_study.sh ...   (default NEEDLES="SB AMB", ANGLES="0"; SB must be among them)
+#   LEAD=1 scripts/crack_study.sh ...      the crack's front 1 mm ahead of A (--crack-lead-mm; default 0)
+#   EXTRA="--relaxing-shear-fraction 0.8 --relaxation-time-ms 0.2" scripts/crack_study.sh ...   another model beside the crack
 #
 # Two runs at once (one core each). A finished run (OUT/<needle>_r<reach>[_a<angles>]/summary.json) is kept, so an
 # interrupted study resumes. About 7 min a run with two at once (19 683 particles).
@@ -26,8 +28,13 @@ for r in "${reaches[@]}"; do
 done
 angles="${ANGLES:-0}"
 [[ "$angles" =~ ^-?[0-9.]+(,-?[0-9.]+)*$ ]] || { echo "crack_study: ANGLES='$angles' is not a comma-separated list of degrees (e.g. 0 or 48.6,-55)" >&2; exit 2; }
+lead="${LEAD:-0}"
+[[ "$lead" =~ ^[0-9]*\.?[0-9]+$ ]] || { echo "crack_study: LEAD='$lead' is not a length in mm (a number >= 0, e.g. 1)" >&2; exit 2; }
+read -r -a extra <<< "${EXTRA:-}"
 suffix=""
 [ "$angles" = "0" ] || suffix="_a${angles//,/_}"
+[[ "$lead" =~ ^0*\.?0*$ ]] || suffix+="_lead$lead"
+for flag in "${extra[@]}"; do suffix+="_${flag#--}"; done  # e.g. _relaxing-shear-fraction_0.8_relaxation-time-ms_0.2
 read -r -a needles <<< "${NEEDLES:-SB AMB}"
 [[ " ${needles[*]} " == *" SB "* ]] || { echo "crack_study: NEEDLES must include SB (the ratios are to SB)" >&2; exit 2; }
 
@@ -37,7 +44,7 @@ source scripts/study_helpers.sh
 csv="$out/crack_study$suffix.csv"
 echo "needle,crack_reach_mm,deflection_mm,bonds_cut_by_crack,coupling_steps,max_energy_balance_error,runtime_s,status" > "$csv.partial"
 for r in "${reaches[@]}"; do
-  flags=(--path-refinement 2 --crack-reach-mm "$r" --crack-angles-deg "$angles")
+  flags=(--path-refinement 2 --crack-reach-mm "$r" --crack-angles-deg "$angles" --crack-lead-mm "$lead" "${extra[@]}")
   study_run_two_at_once crack_study "$out" "_r$r$suffix" "${needles[*]}" "${flags[@]}"
   for needle in "${needles[@]}"; do
     s=$(study_summary crack_study "$out/${needle}_r$r$suffix")

@@ -52,13 +52,14 @@ summary_run_fields() {
 ratio_table() {
   awk -F, -v label="$2" 'NR > 1 { d[$1, $2] = $3; s[$1, $2] = $8; if (!($2 in seen)) { seen[$2] = 1; order[++m] = $2 } if (!($1 in known)) { known[$1] = 1; needle[++k] = $1 } }
   END {
-    printf "%-10s", label
+    w = length(label); for (i = 1; i <= m; ++i) if (length(order[i]) > w) w = length(order[i])  # the case column fits its longest name
+    printf "%-" w "s", label
     for (j = 1; j <= k; ++j) printf " %9s", needle[j]
     for (j = 1; j <= k; ++j) if (needle[j] != "SB") printf " %9s", needle[j] "/SB"
     printf "   (delta in mm at 10 mm)\n"
     for (i = 1; i <= m; ++i) {
       p = order[i]; bad = 0
-      printf "%-10s", p
+      printf "%-" w "s", p
       for (j = 1; j <= k; ++j) {
         if (!((needle[j], p) in d)) { printf " %9s", "-"; continue }  # not run for this case
         printf " %+9.3f", d[needle[j], p]; if (s[needle[j], p] != "finished") bad = 1

@@ -151,7 +151,7 @@ TEST_CASE("needle paper --report-only names the tissue law, the relaxation, the 
                          {{"spacing_mm", 0.4},
                           {"size_mm", {40.0, 16.0, 6.0}},
                           {"contact", {{"cuts_bonds", true}, {"slit_half_height_mm", 1.0}, {"crack_reach_mm", 1.2},
-                                       {"crack_angles_deg", {0.0, -45.0}}, {"cutting_pressure_MPa", 0.3}}},
+                                       {"crack_angles_deg", {0.0, -45.0}}, {"crack_lead_mm", 0.5}, {"cutting_pressure_MPa", 0.3}}},
                           {"material", {{"law", "stiffening_elastic"}, {"relaxing_shear_fraction", 0.5}, {"relaxation_time_ms", 0.2}}}}},
                         {"motion", {{"speed_m_per_s", 4.0}}}};
     std::ofstream(dir / "runs" / name / "scene.json") << scene.dump(2);
@@ -164,7 +164,7 @@ TEST_CASE("needle paper --report-only names the tissue law, the relaxation, the 
                                           "constant 0.2 ms); a 40 x 16 x 6 mm half block (the paper's: 40 x 8 x 2); "
                                           "the tissue also splits in the symmetry plane behind the tip, 1 mm either side of the rod's axis; "
                                           "the tip drives a crack past the rod: fins from the tip point at 0, -45 deg in the cross-section "
-                                          "(0: horizontal), 1.2 mm long; "
+                                          "(0: horizontal), 1.2 mm long, running 0.5 mm ahead of the tip; "
                                           "cutting the tissue costs work: a pressure of 0.3 MPa on the tip facets that advance into it; "
                                           "the needle is driven at 4 m/s") != std::string::npos);
   const std::string tissue = read_json(dir / "results.json")["tissue"].get<std::string>();

@@ -531,8 +531,19 @@ TEST_CASE("needle run --crack-reach-mm: the scene says so, the tip's crack cuts 
   CHECK(cracked.summary["status"] == "finished");
   CHECK(cracked.summary["energy_balance_error"].get<double>() < 0.02);
 
-  // A negative reach, an angle out of range, and a needle without a tip point (the plain rod): one line, exit 2, no run folder.
+  // A front 0.4 mm ahead of A splits the gel the tip has not reached yet: the same crack plus the slab ahead of the tip.
+  const RunFiles leading = run_sb_into_small_block("crack_lead", "--crack-reach-mm 1.0 --crack-lead-mm 0.4");
+  CHECK(leading.scene["tissue"]["contact"]["crack_lead_mm"].get<double>() == 0.4);
+  CHECK(cracked.scene["tissue"]["contact"]["crack_lead_mm"].get<double>() == 0.0);
+  INFO("bonds cut by the crack with its front 0.4 mm ahead " << leading.summary["crack"]["bonds_cut"]);
+  CHECK(leading.summary["crack"]["bonds_cut"].get<long>() > crack_cuts);
+  CHECK(leading.summary["status"] == "finished");
+
+  // A negative reach or lead, an angle out of range, a crack's shape without a crack, and a needle without a tip point (the
+  // plain rod): one line, exit 2, no run folder.
   for (const auto& [flags, message] : {std::pair<std::string, std::string>{"--crack-reach-mm -1", "--crack-reach-mm must be a number >= 0"},
+                                       {"--crack-reach-mm 1 --crack-lead-mm -0.5", "--crack-lead-mm must be a number >= 0"},
+                                       {"--crack-lead-mm 0.5", "--crack-angles-deg and --crack-lead-mm shape the tip's crack: they need --crack-reach-mm above 0"},
                                        {"--crack-reach-mm 1 --crack-angles-deg 0,200", "--crack-angles-deg must be angles from -180 to 180 degrees (got 0,200)"},
                                        {"--crack-reach-mm 1", "a crack from the tip point needs a needle with a ground tip point"}}) {
     const std::string out = refused_on_small_block("crack_bad", flags, message);
