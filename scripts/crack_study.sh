@@ -12,7 +12,7 @@
 #   LEAD=1 scripts/crack_study.sh ...      the crack's front 1 mm ahead of A (--crack-lead-mm; default 0)
 #   EXTRA="--relaxing-shear-fraction 0.8 --relaxation-time-ms 0.2" scripts/crack_study.sh ...   another model beside the crack
 #
-# Two runs at once (one core each). A finished run (OUT/<needle>_r<reach>[_a<angles>]/summary.json) is kept, so an
+# Two runs at once (one core each). A finished run (OUT/<needle>_r<reach>[_a<angles>][_lead<L>][_<EXTRA words>]/summary.json) is kept, so an
 # interrupted study resumes. About 7 min a run with two at once (19 683 particles).
 set -euo pipefail
 cd "$(dirname "$0")/.."
