@@ -393,6 +393,11 @@ void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
   NEEDLE_REQUIRE((o.crack_angles_deg.empty() && std::isnan(o.crack_lead_mm)) || scene.tissue.contact.crack.enabled(),
                  "--crack-angles-deg and --crack-lead-mm shape the tip's crack: they need --crack-reach-mm above 0 (or a scene with "
                  "tissue.contact.crack_reach_mm)");
+  if (given(o.groove_start_mm, "--groove-start-mm")) {
+    NEEDLE_REQUIRE(scene.needle.mesh_file.empty() && !scene.needle.plain_rod,
+                   "--groove-start-mm moves the groove of a ground tip: it needs a preset, d_a or a recipe (not a plain rod or a mesh file)");
+    scene.needle.groove_start_mm = o.groove_start_mm;
+  }
 }
 
 void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
@@ -447,6 +452,9 @@ void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
   c->add_option("--crack-lead-mm", o.crack_lead_mm,
                 "The crack's front runs this far ahead of tip point A, so the gel splits before the tip reaches it (default 0: "
                 "it opens as the tip passes; scene key tissue.contact.crack_lead_mm)");
+  c->add_option("--groove-start-mm", o.groove_start_mm,
+                "The groove's front wall this far behind tip point A. The paper does not give it; the presets' 3 mm clears the SB "
+                "bevel's heel (2.3 mm) (default: the recipe's; scene key needle.groove_start_mm)");
 }
 
 std::string scene_override_arguments(const SceneOverrides& o) {
@@ -470,6 +478,7 @@ std::string scene_override_arguments(const SceneOverrides& o) {
   if (!std::isnan(o.crack_reach_mm)) line += fmt::format(" --crack-reach-mm {}", o.crack_reach_mm);
   if (!o.crack_angles_deg.empty()) line += fmt::format(" --crack-angles-deg {}", fmt::join(o.crack_angles_deg, ","));
   if (!std::isnan(o.crack_lead_mm)) line += fmt::format(" --crack-lead-mm {}", o.crack_lead_mm);
+  if (!std::isnan(o.groove_start_mm)) line += fmt::format(" --groove-start-mm {}", o.groove_start_mm);
   return line;
 }
 

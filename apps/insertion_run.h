@@ -48,12 +48,13 @@ struct SceneOverrides {
   double crack_reach_mm = std::nan("");           // the tip's crack runs this far from tip point A (0: none, the default)
   std::vector<double> crack_angles_deg;           // its fins' directions in the cross-section (empty: the scene's; 0: horizontal)
   double crack_lead_mm = std::nan("");            // its front runs this far ahead of A (0: it opens as the tip passes)
+  double groove_start_mm = std::nan("");          // the groove's front wall behind A (not given by the paper; the presets' 3 mm)
 };
 // InputError naming the flag for a value that is not a positive number.
 void apply_scene_overrides(Scene& scene, const SceneOverrides& overrides);
 // The flags run, paper and calibrate share: --travel-mm, --spacing-mm, --path-refinement, --no-needle-cut, --tissue-nu,
 // --tissue-friction, --tissue-law, --speed-m-per-s, --decel-time-ms, --hold-ms, --tissue-size-mm, --slit-half-height-mm, --relaxing-shear-fraction, --relaxation-time-ms, --cutting-pressure-mpa,
-// --crack-reach-mm, --crack-angles-deg, --crack-lead-mm (each command
+// --crack-reach-mm, --crack-angles-deg, --crack-lead-mm, --groove-start-mm (each command
 // adds --mesh-size-mm itself where it has it).
 void add_scene_override_options(CLI::App* command, SceneOverrides& overrides);
 // The flags that give these overrides again (each given value, with a leading space), for a command

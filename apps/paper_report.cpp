@@ -127,6 +127,11 @@ NeedleRun read_run(const std::string& out_dir, const std::string& name) {
                                          paper_drive.speed_mm_per_ms);
     if (decel_ms != paper_drive.decel_time_ms) r.model_description += fmt::format("; the base decelerates to rest over {:g} ms", decel_ms);
     if (hold_ms != paper_drive.hold_ms) r.model_description += fmt::format("; delta is read after the base is held still for {:g} ms", hold_ms);
+    // The presets' groove (its front wall 3 mm behind A) goes unnamed; another start is said.
+    const json needle_scene = scene.value("needle", json::object());
+    if (needle_scene.contains("groove_start_mm"))
+      r.model_description += fmt::format("; the groove starts {:g} mm behind the tip point (the presets': {:g})",
+                                         needle_scene["groove_start_mm"].get<double>(), Groove{}.start_behind_tip_mm);
   }
   r.history = read_csv_table((fs::path(r.folder) / "history.csv").string());
   r.facets = read_csv_table((fs::path(r.folder) / "facet_forces.csv").string());

@@ -31,6 +31,10 @@ void read_needle(SceneObject o, NeedleScene& n, const std::string& scene_folder)
     *file = p.string();
   }
   n.length_mm = o.quantity("length", Dimension::length, n.length_mm, positive());
+  n.groove_start_mm = o.quantity("groove_start", Dimension::length, n.groove_start_mm, positive());
+  NEEDLE_REQUIRE(std::isnan(n.groove_start_mm) || (n.mesh_file.empty() && !n.plain_rod),
+                 fmt::format("{}: a groove start moves the groove of a ground tip (a preset, d_a_mm or a recipe), not of a plain "
+                             "rod or a mesh file", o.where("groove_start_mm")));
   n.half_model = o.boolean("half_model", n.half_model);
   if (o.has("mesh")) {
     SceneObject m = o.child("mesh");
@@ -199,6 +203,7 @@ json scene_to_json(const Scene& s) {
   if (!n.recipe_file.empty()) needle["recipe"] = std::filesystem::absolute(n.recipe_file).string();
   if (!n.mesh_file.empty()) needle["mesh_file"] = std::filesystem::absolute(n.mesh_file).string();
   if (n.plain_rod) needle["plain_rod"] = true;
+  if (!std::isnan(n.groove_start_mm)) needle["groove_start_mm"] = n.groove_start_mm;
   needle["mesh"] = {{"order", n.mesh.order}, {"size_mm", n.mesh.size_mm}, {"tip_size_mm", n.mesh.tip_size_mm},
                     {"edge_size_mm", n.mesh.edge_size_mm}, {"shaft_size_mm", n.mesh.shaft_size_mm}, {"grading_mm", n.mesh.grading_mm}};
   needle["material"] = {{"youngs_modulus_MPa", n.material.youngs_modulus_MPa}, {"poisson_ratio", n.material.poisson_ratio},

@@ -24,6 +24,8 @@ struct NeedleScene {
   double d_a_mm = std::nan("");
   bool plain_rod = false;
   double length_mm = 40.0;  // modelled length from tip point A back to the driven base plane
+  // The groove's front wall this far behind A (the paper does not give it); NaN: the recipe's (the presets' 3 mm).
+  double groove_start_mm = std::nan("");
   bool half_model = true;   // z >= 0 half with a symmetry plane (paper)
   NeedleMeshOptions mesh;   // T10, 0.2 mm (paper)
   NeedleMaterial material;  // AISI 304

@@ -1,7 +1,10 @@
 #include "apps/scene_needle.h"
 
+#include <cmath>
+
 #include "apps/needle_build.h"
 #include "apps/recipe_json.h"
+#include "geometry/input_error.h"
 #include "geometry/grinding_recipe.h"
 #include "mesher/msh_file.h"
 #include "mesher/vtk_files.h"
@@ -26,6 +29,11 @@ SceneNeedle build_scene_needle(const NeedleScene& n) {
                             : !n.recipe_file.empty() ? read_recipe_file(n.recipe_file)
                                                      : multi_bevel_recipe(n.d_a_mm);
     recipe.rod.length_mm = n.length_mm;
+    if (!std::isnan(n.groove_start_mm)) {
+      NEEDLE_REQUIRE(recipe.groove.has_value(), "a groove start was given (--groove-start-mm, scene key needle.groove_start_mm) but "
+                                                "the recipe has no groove");
+      recipe.groove->start_behind_tip_mm = n.groove_start_mm;
+    }
     tip = resolve_tip(recipe);
   }
   const NeedleBuild build = build_needle(tip, n.half_model, n.mesh);

@@ -1,6 +1,7 @@
 // Scene files and `needle simulate` as a user runs them: a small scene end to end, the run folder's
 // contents checked against the solver's own invariants, and bad scenes refused with file, line and
 // key, leaving no folder behind. Also `needle stiffness --json`.
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <fmt/format.h>
 #include <filesystem>
@@ -10,6 +11,7 @@
 
 #include "apps/csv_table.h"
 #include "apps/scene.h"
+#include "apps/scene_needle.h"
 #include "cli_run.h"
 #include "geometry/input_error.h"
 
@@ -550,4 +552,46 @@ TEST_CASE("needle run --crack-reach-mm: the scene says so, the tip's crack cuts 
     INFO(flags << ": " << out);
     CHECK(std::count(out.begin(), out.end(), '\n') == 1);
   }
+}
+
+TEST_CASE("needle run --groove-start-mm: the scene says so, the built needle's groove floor starts there, bad input is refused",
+          "[apps][gmsh][scene]") {
+  // The paper does not say where the groove starts. The scene key moves the groove's front wall of any ground tip: the
+  // groove box and the mesh's groove_floor nodes must start that far behind A, and the default stays the presets' 3 mm.
+  auto groove_front_x = [](const std::string& needle_keys) {
+    const needle::Scene scene =
+        needle::parse_scene(R"({"needle": {)" + needle_keys + R"(, "length_mm": 30, "mesh": {"order": 1, "size_mm": 0.5}}})", "scene.json");
+    const needle::SceneNeedle built = needle::build_scene_needle(scene.needle);
+    REQUIRE(built.groove.has_value());
+    double floor_front_x = -1e9;  // the groove floor's most distal node
+    for (int node : needle::nodes_with_tag(built.mesh, "groove_floor")) floor_front_x = std::max(floor_front_x, built.mesh.X(node, 0));
+    return std::pair<double, double>{built.groove->front_x_mm - built.tip_point.x(), floor_front_x - built.tip_point.x()};
+  };
+  const auto [preset_box, preset_floor] = groove_front_x(R"("preset": "AMB")");
+  const auto [moved_box, moved_floor] = groove_front_x(R"("preset": "AMB", "groove_start_mm": 5.5)");
+  const auto [d_a_box, d_a_floor] = groove_front_x(R"("d_a_mm": -0.1, "groove_start": "7 mm")");
+  INFO("groove front behind A: preset " << preset_box << " / " << preset_floor << ", moved " << moved_box << " / " << moved_floor
+                                        << ", d_a " << d_a_box << " / " << d_a_floor);
+  CHECK(preset_box == Approx(-3.0).margin(1e-9));
+  CHECK(preset_floor == Approx(-3.0).margin(1e-6));
+  CHECK(moved_box == Approx(-5.5).margin(1e-9));
+  CHECK(moved_floor == Approx(-5.5).margin(1e-6));
+  CHECK(d_a_box == Approx(-7.0).margin(1e-9));
+  CHECK(d_a_floor == Approx(-7.0).margin(1e-6));
+
+  // On the command line: the key is written only when given, and the run goes through.
+  const RunFiles presets = run_sb_into_small_block("groove_default", "");
+  const RunFiles moved = run_sb_into_small_block("groove_moved", "--groove-start-mm 3.5");  // its 22 mm groove still ends inside the 26 mm rod
+  CHECK_FALSE(presets.scene["needle"].contains("groove_start_mm"));
+  CHECK(moved.scene["needle"]["groove_start_mm"].get<double>() == 3.5);
+  CHECK(moved.summary["status"] == "finished");
+
+  // A start that is not positive, a plain rod (no groove to move), and the scene key on a mesh file: one line, exit 2.
+  for (const auto& [flags, message] : {std::pair<std::string, std::string>{"--groove-start-mm 0", "--groove-start-mm must be a positive number"},
+                                       {"--groove-start-mm 4", "--groove-start-mm moves the groove of a ground tip"}}) {
+    const std::string out = refused_on_small_block("groove_bad", flags, message);
+    CHECK(std::count(out.begin(), out.end(), '\n') == 1);
+  }
+  CHECK(message_of(R"({"needle": {"plain_rod": true, "groove_start_mm": 4}})").find("a groove start moves the groove of a ground tip") !=
+        std::string::npos);
 }
