@@ -35,11 +35,10 @@ suffix=""
 [ "$angles" = "0" ] || suffix="_a${angles//,/_}"
 [[ "$lead" =~ ^0*\.?0*$ ]] || suffix+="_lead$lead"
 for flag in "${extra[@]}"; do suffix+="_${flag#--}"; done  # e.g. _relaxing-shear-fraction_0.8_relaxation-time-ms_0.2
-read -r -a needles <<< "${NEEDLES:-SB AMB}"
-[[ " ${needles[*]} " == *" SB "* ]] || { echo "crack_study: NEEDLES must include SB (the ratios are to SB)" >&2; exit 2; }
 
 # shellcheck source=scripts/study_helpers.sh
 source scripts/study_helpers.sh
+study_needles crack_study
 
 csv="$out/crack_study$suffix.csv"
 echo "needle,crack_reach_mm,deflection_mm,bonds_cut_by_crack,coupling_steps,max_energy_balance_error,runtime_s,status" > "$csv.partial"

@@ -25,11 +25,10 @@ pressures=("$@")
 for p in "${pressures[@]}"; do
   [[ "$p" =~ ^[0-9]*\.?[0-9]+$ ]] || { echo "cutting_study: '$p' is not a pressure in MPa (a number >= 0, e.g. 0.1)" >&2; exit 2; }
 done
-read -r -a needles <<< "${NEEDLES:-SB AMB}"
-[[ " ${needles[*]} " == *" SB "* ]] || { echo "cutting_study: NEEDLES must include SB (the ratios are to SB)" >&2; exit 2; }
 
 # shellcheck source=scripts/study_helpers.sh
 source scripts/study_helpers.sh
+study_needles cutting_study
 
 csv="$out/cutting_study.csv"
 echo "needle,cutting_pressure_MPa,deflection_mm,cutting_work_mJ,coupling_steps,max_energy_balance_error,runtime_s,status" > "$csv.partial"

@@ -24,11 +24,10 @@ starts=("$@")
 for g in "${starts[@]}"; do
   [[ "$g" =~ ^[0-9]*\.?[0-9]+$ ]] && [[ ! "$g" =~ ^0*\.?0*$ ]] || { echo "groove_start_study: '$g' is not a start in mm (a number > 0, e.g. 5)" >&2; exit 2; }
 done
-read -r -a needles <<< "${NEEDLES:-SB AMB}"
-[[ " ${needles[*]} " == *" SB "* ]] || { echo "groove_start_study: NEEDLES must include SB (the ratios are to SB)" >&2; exit 2; }
 
 # shellcheck source=scripts/study_helpers.sh
 source scripts/study_helpers.sh
+study_needles groove_start_study
 
 csv="$out/groove_start_study.csv"
 echo "needle,groove_start_mm,deflection_mm,groove_fill,coupling_steps,max_energy_balance_error,runtime_s,status" > "$csv.partial"

@@ -28,6 +28,13 @@ study_run_two_at_once() {
   done
 }
 
+# study_needles STUDY: the NEEDLES the study runs (default "SB AMB") into the array `needles`; SB must be among them, since
+# the ratios are to SB (one line and exit 2 otherwise).
+study_needles() {
+  read -r -a needles <<< "${NEEDLES:-SB AMB}"
+  [[ " ${needles[*]} " == *" SB "* ]] || { echo "$1: NEEDLES must include SB (the ratios are to SB)" >&2; exit 2; }
+}
+
 # study_summary STUDY RUN: RUN's summary.json, or a message and failure when there is none.
 study_summary() {
   [ -f "$2/summary.json" ] || { echo "$1: no summary in $2" >&2; return 1; }
