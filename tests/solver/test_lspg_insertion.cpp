@@ -1,6 +1,7 @@
 // The coupled L-SPG insertion on small scenes: energy and momentum balance of a needle driven into
 // tissue, Coulomb friction recovered by a sliding block, no particle left inside the needle, and the
-// subcycled / mass-scaled needle against the plain full model.
+// subcycled / mass-scaled needle against the plain full model, and a needle and its mirror image deflecting
+// by as much, opposite ways.
 #include <catch2/catch.hpp>
 #include <algorithm>
 #include <cmath>
