@@ -398,6 +398,11 @@ void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
                    "--groove-start-mm moves the groove of a ground tip: it needs a preset, d_a or a recipe (not a plain rod or a mesh file)");
     scene.needle.groove_start_mm = o.groove_start_mm;
   }
+  if (given_or_zero(o.contact_skin_mm, "--contact-skin-mm")) scene.tissue.contact.skin_mm = o.contact_skin_mm;
+  if (given(o.contact_stiffness_factor, "--contact-stiffness-factor")) {
+    NEEDLE_REQUIRE(o.contact_stiffness_factor <= 1e4, fmt::format("--contact-stiffness-factor must be at most 1e4 (got {})", o.contact_stiffness_factor));
+    scene.tissue.contact.stiffness_factor = o.contact_stiffness_factor;
+  }
 }
 
 void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
@@ -455,6 +460,12 @@ void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
   c->add_option("--groove-start-mm", o.groove_start_mm,
                 "The groove's front wall this far behind tip point A. The paper does not give it; the presets' 3 mm clears the SB "
                 "bevel's heel (2.3 mm) (default: the recipe's; scene key needle.groove_start_mm)");
+  c->add_option("--contact-skin-mm", o.contact_skin_mm,
+                "The penalty contact's skin: particles feel the needle this far outside its surface, so the needle acts that much "
+                "thicker (a numerical parameter, 0 is exact contact; default 0.04; scene key tissue.contact.skin_mm)");
+  c->add_option("--contact-stiffness-factor", o.contact_stiffness_factor,
+                "The penalty's stiffness as a multiple of the particle's own (a numerical parameter: stiffer holds particles nearer "
+                "the skin and takes more tissue steps; default 10; scene key tissue.contact.stiffness_factor)");
 }
 
 std::string scene_override_arguments(const SceneOverrides& o) {
@@ -479,6 +490,8 @@ std::string scene_override_arguments(const SceneOverrides& o) {
   if (!o.crack_angles_deg.empty()) line += fmt::format(" --crack-angles-deg {}", fmt::join(o.crack_angles_deg, ","));
   if (!std::isnan(o.crack_lead_mm)) line += fmt::format(" --crack-lead-mm {}", o.crack_lead_mm);
   if (!std::isnan(o.groove_start_mm)) line += fmt::format(" --groove-start-mm {}", o.groove_start_mm);
+  if (!std::isnan(o.contact_skin_mm)) line += fmt::format(" --contact-skin-mm {}", o.contact_skin_mm);
+  if (!std::isnan(o.contact_stiffness_factor)) line += fmt::format(" --contact-stiffness-factor {}", o.contact_stiffness_factor);
   return line;
 }
 

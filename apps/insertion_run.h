@@ -49,12 +49,14 @@ struct SceneOverrides {
   std::vector<double> crack_angles_deg;           // its fins' directions in the cross-section (empty: the scene's; 0: horizontal)
   double crack_lead_mm = std::nan("");            // its front runs this far ahead of A (0: it opens as the tip passes)
   double groove_start_mm = std::nan("");          // the groove's front wall behind A (not given by the paper; the presets' 3 mm)
+  double contact_skin_mm = std::nan("");          // the penalty contact's skin: particles are held this far off the surface (default 0.04)
+  double contact_stiffness_factor = std::nan(""); // the penalty's stiffness over the particle's own (default 10)
 };
 // InputError naming the flag for a value that is not a positive number.
 void apply_scene_overrides(Scene& scene, const SceneOverrides& overrides);
 // The flags run, paper and calibrate share: --travel-mm, --spacing-mm, --path-refinement, --no-needle-cut, --tissue-nu,
 // --tissue-friction, --tissue-law, --speed-m-per-s, --decel-time-ms, --hold-ms, --tissue-size-mm, --slit-half-height-mm, --relaxing-shear-fraction, --relaxation-time-ms, --cutting-pressure-mpa,
-// --crack-reach-mm, --crack-angles-deg, --crack-lead-mm, --groove-start-mm (each command
+// --crack-reach-mm, --crack-angles-deg, --crack-lead-mm, --groove-start-mm, --contact-skin-mm, --contact-stiffness-factor (each command
 // adds --mesh-size-mm itself where it has it).
 void add_scene_override_options(CLI::App* command, SceneOverrides& overrides);
 // The flags that give these overrides again (each given value, with a leading space), for a command

@@ -110,6 +110,13 @@ NeedleRun read_run(const std::string& out_dir, const std::string& name) {
         const double lead_mm = contact.value("crack_lead_mm", 0.0);
         if (lead_mm > 0) r.model_description += fmt::format(", running {:g} mm ahead of the tip", lead_mm);
       }
+      // The default contact (skin 0.04 mm, stiffness factor 10) goes unnamed; another is said.
+      const ContactOptions default_contact;
+      const double skin_mm = contact.value("skin_mm", default_contact.skin_mm);
+      const double stiffness_factor = contact.value("stiffness_factor", default_contact.stiffness_factor);
+      if (skin_mm != default_contact.skin_mm || stiffness_factor != default_contact.stiffness_factor)
+        r.model_description += fmt::format("; the contact's skin is {:g} mm and its stiffness factor {:g} (the defaults: {:g} and {:g})", skin_mm,
+                                           stiffness_factor, default_contact.skin_mm, default_contact.stiffness_factor);
       // No cutting resistance is the default and goes unnamed; a resistance is said.
       const double cutting_MPa = contact.value("cutting_pressure_MPa", 0.0);
       if (cutting_MPa > 0)

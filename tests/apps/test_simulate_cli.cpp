@@ -595,3 +595,41 @@ TEST_CASE("needle run --groove-start-mm: the scene says so, the built needle's g
   CHECK(message_of(R"({"needle": {"plain_rod": true, "groove_start_mm": 4}})").find("a groove start moves the groove of a ground tip") !=
         std::string::npos);
 }
+
+TEST_CASE("needle run --contact-skin-mm, --contact-stiffness-factor: the scene says so, the solver feels both, bad input is refused",
+          "[apps][lspg][gmsh][contact]") {
+  // The penalty contact's two numerical parameters (solver/needle_tissue_contact.h). The skin holds the particles off the
+  // needle's true surface: without it they sink into the rod until the penalty holds them, with a thin one less, with the
+  // default 0.04 mm hardly at all (the rod pushed 0.8 mm in). The tissue's step is capped by the contact's own stable step,
+  // which goes as 1 / sqrt(k): three times the stiffness takes about sqrt(3) times the steps.
+  const RunFiles defaults = run_rod_into_small_block("contact_default", "");
+  const RunFiles exact = run_rod_into_small_block("contact_skin0", "--contact-skin-mm 0");
+  const RunFiles thin = run_rod_into_small_block("contact_skin0.02", "--contact-skin-mm 0.02");
+  const RunFiles stiff = run_rod_into_small_block("contact_k30", "--contact-stiffness-factor 30");
+  CHECK(defaults.scene["tissue"]["contact"]["skin_mm"].get<double>() == 0.04);
+  CHECK(exact.scene["tissue"]["contact"]["skin_mm"].get<double>() == 0.0);
+  CHECK(thin.scene["tissue"]["contact"]["skin_mm"].get<double>() == 0.02);
+  CHECK(stiff.scene["tissue"]["contact"]["stiffness_factor"].get<double>() == 30.0);
+  const double depth_exact = exact.summary["max_penetration_mm"].get<double>();
+  const double depth_thin = thin.summary["max_penetration_mm"].get<double>();
+  const double depth_default = defaults.summary["max_penetration_mm"].get<double>();
+  const double steps_ratio = stiff.summary["steps"].get<double>() / defaults.summary["steps"].get<double>();
+  INFO("deepest particle below the rod's surface at skin 0 / 0.02 / 0.04 mm: " << depth_exact << " / " << depth_thin << " / " << depth_default
+                                                                               << " mm; steps at stiffness 30 over 10: " << steps_ratio);
+  CHECK(depth_exact > depth_thin);
+  CHECK(depth_thin > depth_default);
+  CHECK(depth_exact > 0.01);
+  CHECK(steps_ratio == Approx(std::sqrt(3.0)).epsilon(0.15));
+  for (const RunFiles* r : {&exact, &thin, &stiff}) {
+    CHECK(r->summary["status"] == "finished");
+    CHECK(r->summary["energy_balance_error"].get<double>() < 0.02);
+  }
+
+  // A negative skin, a stiffness factor that is not positive or beyond 1e4: one line, exit 2, no run folder.
+  for (const auto& [flags, message] : {std::pair<std::string, std::string>{"--contact-skin-mm -0.01", "--contact-skin-mm must be a number >= 0"},
+                                       {"--contact-stiffness-factor 0", "--contact-stiffness-factor must be a positive number"},
+                                       {"--contact-stiffness-factor 2e4", "--contact-stiffness-factor must be at most 1e4"}}) {
+    const std::string out = refused_on_small_block("contact_bad", flags, message);
+    CHECK(std::count(out.begin(), out.end(), '\n') == 1);
+  }
+}
