@@ -1,13 +1,15 @@
 # Sourced by the 10 mm study scripts (scripts/*_study.sh): run cases, read fields of their summary.json without a JSON tool, print ratio tables.
 
-# study_run STUDY RUN NEEDLE [FLAG...]: NEEDLE 10 mm into data/scenes/spacing_study_10mm.json with the FLAGs, into the folder RUN,
-# unless RUN already holds a run (so an interrupted study resumes). A run the solver stopped is kept and reported with its status;
-# no summary at all ends the study.
+# study_run STUDY RUN NEEDLE [FLAG...]: NEEDLE (a preset name, or a recipe file *.json) 10 mm into
+# data/scenes/spacing_study_10mm.json with the FLAGs, into the folder RUN, unless RUN already holds a run (so an interrupted study
+# resumes). A run the solver stopped is kept and reported with its status; no summary at all ends the study.
 study_run() {
   local study="$1" run="$2" needle="$3"
   shift 3
+  local -a source=(--preset "$needle")
+  [[ "$needle" == *.json ]] && source=(--recipe "$needle")
   if [ ! -f "$run/summary.json" ]; then
-    ./build/apps/needle run --scene data/scenes/spacing_study_10mm.json --preset "$needle" "$@" --out "$run" --overwrite || true
+    ./build/apps/needle run --scene data/scenes/spacing_study_10mm.json "${source[@]}" "$@" --out "$run" --overwrite || true
   fi
   [ -f "$run/summary.json" ] || { echo "$study: no summary in $run" >&2; exit 1; }
 }

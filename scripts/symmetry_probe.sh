@@ -21,10 +21,7 @@ mkdir -p "$out"
 source scripts/study_helpers.sh
 
 cases=(sb_no_groove sb_upside_down symmetric_pyramid)
-probe_run() {
-  [ -f "$out/$1/summary.json" ] || ./build/apps/needle run --scene data/scenes/spacing_study_10mm.json --recipe "data/recipes/$1.json" \
-    --path-refinement 2 --threads 1 --quiet --out "$out/$1" --overwrite || true
-}
+probe_run() { study_run symmetry_probe "$out/$1" "data/recipes/$1.json" --path-refinement 2 --threads 1 --quiet; }
 { probe_run "${cases[0]}" & }
 { probe_run "${cases[1]}" & }
 wait
