@@ -3,7 +3,8 @@
 // paper's scene (DIR/runs/E_<value>MPa, reused when already there with the same scene); the first step
 // assumes deflection proportional to E, the next ones are secant steps on the last two runs. Once the
 // target is met, one more run at E (1 + sensitivity step) measures the local slope d delta / d E, unless
-// a finished run already lies that close. Writes DIR/calibration.json (E, every run, the sensitivity)
+// a finished run already lies that close: one of this calibration's, or a run of the same scene at another E
+// already in DIR/runs (an earlier calibration's, or one run beside it). Writes DIR/calibration.json (E, every run, the sensitivity)
 // and DIR/calibration.png.
 #include "apps/calibrate_command.h"
 
@@ -43,6 +44,18 @@ struct Evaluation {
   std::string status, folder;
 };
 
+Evaluation read_evaluation(double E, const fs::path& folder) {
+  const json s = read_json_file((folder / "summary.json").string(), "run summary");
+  Evaluation e;
+  e.E_MPa = E;
+  e.deflection_mm = s.at("deflection_mm").get<double>();
+  e.insertion_mm = s.at("insertion_mm").get<double>();
+  e.runtime_s = s.at("runtime_s").get<double>();
+  e.status = s.at("status").get<std::string>();
+  e.folder = folder.string();
+  return e;
+}
+
 Evaluation evaluate(const Scene& base, double E, const fs::path& runs_dir, const CalibrateOptions& o) {
   Scene scene = base;
   scene.tissue.material.E_MPa = E;
@@ -56,15 +69,30 @@ Evaluation evaluate(const Scene& base, double E, const fs::path& runs_dir, const
   run.throw_on_stop = false;
   const bool reused = run_insertion_unless_done(scene, run);
   if (!o.quiet) fmt::print("E = {:.6g} MPa: {} {}\n", E, reused ? "reused" : "ran", folder.string());
-  const json s = read_json_file((folder / "summary.json").string(), "run summary");
-  Evaluation e;
-  e.E_MPa = E;
-  e.deflection_mm = s.at("deflection_mm").get<double>();
-  e.insertion_mm = s.at("insertion_mm").get<double>();
-  e.runtime_s = s.at("runtime_s").get<double>();
-  e.status = s.at("status").get<std::string>();
-  e.folder = folder.string();
-  return e;
+  return read_evaluation(E, folder);
+}
+
+// The runs of this scene at other E than those in `have` already in runs_dir (folders E_<value>MPa whose
+// scene.json is the scene at that E), by E. Folders of another scene, partial runs and other files are passed over.
+std::vector<Evaluation> runs_already_there(const Scene& base, const fs::path& runs_dir, const std::vector<Evaluation>& have) {
+  std::vector<Evaluation> found;
+  for (const fs::directory_entry& entry : fs::directory_iterator(runs_dir)) {
+    const std::string name = entry.path().filename().string();
+    if (!entry.is_directory() || name.rfind("E_", 0) != 0 || !fs::is_regular_file(entry.path() / "scene.json")) continue;
+    double E = std::nan("");
+    try {
+      E = read_json_file((entry.path() / "scene.json").string(), "run scene").at("tissue").at("material").at("E_MPa").get<double>();
+    } catch (const std::exception&) {
+      continue;  // not a run scene
+    }
+    const bool known = std::any_of(have.begin(), have.end(), [&](const Evaluation& e) { return std::abs(e.E_MPa - E) <= 1e-12 * E; });
+    if (known || !(E > 0)) continue;
+    Scene scene = base;
+    scene.tissue.material.E_MPa = E;
+    if (folder_holds_run_of(scene, entry.path().string())) found.push_back(read_evaluation(E, entry.path()));
+  }
+  std::sort(found.begin(), found.end(), [](const Evaluation& a, const Evaluation& b) { return a.E_MPa < b.E_MPa; });
+  return found;
 }
 
 void calibrate(const CalibrateOptions& o) {
@@ -96,8 +124,12 @@ void calibrate(const CalibrateOptions& o) {
   while (!converged(runs.back()) && static_cast<int>(runs.size()) < o.max_runs)
     runs.push_back(evaluate(scene, next_calibration_E_MPa(points(), o.target_mm), dir / "runs", o));
 
-  // The best run; its slope comes from the finished run nearest to it in E, made here when none lies
-  // within twice the sensitivity step.
+  // Runs of the same scene already there count too, so none is repeated. The best run's slope comes from
+  // the finished run nearest to it in E, made here when none lies within twice the sensitivity step.
+  for (const Evaluation& e : runs_already_there(scene, dir / "runs", runs)) {
+    if (!o.quiet) fmt::print("E = {:.6g} MPa: already there, {}\n", e.E_MPa, e.folder);
+    runs.push_back(e);
+  }
   std::size_t best_index = nearest_to_target(points(), o.target_mm);
   if (o.sensitivity_step > 0 && converged(runs[best_index]) && needs_sensitivity_run(points(), best_index, o.sensitivity_step)) {
     if (!o.quiet) fmt::print("sensitivity run at E (1 + {:g})\n", o.sensitivity_step);
@@ -156,7 +188,7 @@ void add_calibrate_command(CLI::App& app) {
   c->add_option("--max-runs", o->max_runs, "Most runs to make toward the target (default 4)");
   c->add_option("--sensitivity-step", o->sensitivity_step,
                 "Relative change of E for one extra run after convergence that measures d delta / d E, made unless a finished "
-                "run already lies within twice this (default 0.2; 0: none)");
+                "run lies within twice this, this calibration's or one of the same scene already in OUT/runs (default 0.2; 0: none)");
   add_scene_override_options(c, o->overrides);
   c->add_flag("--quiet", o->quiet, "No progress bars or result lines");
   c->add_option("--threads", o->threads, "Worker threads (default: the scene's; 0: all cores)");

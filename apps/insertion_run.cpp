@@ -312,17 +312,19 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
   if (status != "finished" && o.throw_on_stop) throw SolverError(reason + fmt::format(" (what was written so far is in {})", o.out_dir));
 }
 
-bool run_insertion_unless_done(const Scene& scene, const RunOptions& options) {
-  const std::filesystem::path folder(options.out_dir);
+bool folder_holds_run_of(const Scene& scene, const std::string& folder_name) {
+  const std::filesystem::path folder(folder_name);
   std::ifstream summary(folder / "summary.json"), stored(folder / "scene.json");
-  bool done = false;
-  if (summary.good() && stored.good()) {
-    try {
-      done = json::parse(stored) == json::parse(scene_to_json(scene).dump());
-    } catch (const json::exception&) {
-      done = false;  // an unreadable folder is run again
-    }
+  if (!summary.good() || !stored.good()) return false;
+  try {
+    return json::parse(stored) == json::parse(scene_to_json(scene).dump());
+  } catch (const json::exception&) {
+    return false;  // an unreadable folder holds no run
   }
+}
+
+bool run_insertion_unless_done(const Scene& scene, const RunOptions& options) {
+  const bool done = folder_holds_run_of(scene, options.out_dir);
   if (!done) run_insertion(scene, options);
   return done;
 }

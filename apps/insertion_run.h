@@ -30,6 +30,9 @@ void run_insertion(const Scene& scene, const RunOptions& options);
 // this scene (scene.json); true if it reused one. An interrupted `paper` or `calibrate` resumes this way.
 bool run_insertion_unless_done(const Scene& scene, const RunOptions& options);
 
+// Whether folder holds a run (summary.json, finished or stopped) of exactly this scene (scene.json).
+bool folder_holds_run_of(const Scene& scene, const std::string& folder);
+
 // The scene flags `needle run`, `paper` and `calibrate` share; NaN keeps the scene's value.
 struct SceneOverrides {
   double travel_mm = std::nan(""), spacing_mm = std::nan(""), mesh_size_mm = std::nan("");
