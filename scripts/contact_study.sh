@@ -20,17 +20,17 @@ out="${1:-out/contact}"
 shift || true
 [ -x build/apps/needle ] || bash scripts/build.sh
 mkdir -p "$out"
+# shellcheck source=scripts/study_helpers.sh
+source scripts/study_helpers.sh
 
 k="${K:-10}"
-[[ "$k" =~ ^[0-9]*\.?[0-9]+$ ]] && [[ ! "$k" =~ ^0*\.?0*$ ]] || { echo "contact_study: K='$k' is not a stiffness factor (a number > 0, e.g. 30)" >&2; exit 2; }
+study_number contact_study "K='$k'" "$k" ">0" "a stiffness factor" 30
 skins=("$@")
 [ "${#skins[@]}" -gt 0 ] || skins=(0.02)
 for s in "${skins[@]}"; do
-  [[ "$s" =~ ^[0-9]*\.?[0-9]+$ ]] || { echo "contact_study: '$s' is not a skin in mm (a number >= 0, e.g. 0.02)" >&2; exit 2; }
+  study_number contact_study "'$s'" "$s" ">=0" "a skin in mm" 0.02
 done
 
-# shellcheck source=scripts/study_helpers.sh
-source scripts/study_helpers.sh
 study_needles contact_study
 
 csv="$out/contact_study_k$k.csv"

@@ -20,24 +20,24 @@ out="${1:-out/crack}"
 shift || true
 [ -x build/apps/needle ] || bash scripts/build.sh
 mkdir -p "$out"
+# shellcheck source=scripts/study_helpers.sh
+source scripts/study_helpers.sh
 
 reaches=("$@")
 [ "${#reaches[@]}" -gt 0 ] || reaches=(1 2)
 for r in "${reaches[@]}"; do
-  [[ "$r" =~ ^[0-9]*\.?[0-9]+$ ]] && [[ ! "$r" =~ ^0*\.?0*$ ]] || { echo "crack_study: '$r' is not a reach in mm (a number > 0, e.g. 1)" >&2; exit 2; }
+  study_number crack_study "'$r'" "$r" ">0" "a reach in mm" 1
 done
 angles="${ANGLES:-0}"
 [[ "$angles" =~ ^-?[0-9.]+(,-?[0-9.]+)*$ ]] || { echo "crack_study: ANGLES='$angles' is not a comma-separated list of degrees (e.g. 0 or 48.6,-55)" >&2; exit 2; }
 lead="${LEAD:-0}"
-[[ "$lead" =~ ^[0-9]*\.?[0-9]+$ ]] || { echo "crack_study: LEAD='$lead' is not a length in mm (a number >= 0, e.g. 1)" >&2; exit 2; }
+study_number crack_study "LEAD='$lead'" "$lead" ">=0" "a length in mm" 1
 read -r -a extra <<< "${EXTRA:-}"
 suffix=""
 [ "$angles" = "0" ] || suffix="_a${angles//,/_}"
 [[ "$lead" =~ ^0*\.?0*$ ]] || suffix+="_lead$lead"
 for flag in "${extra[@]}"; do suffix+="_${flag#--}"; done  # e.g. _relaxing-shear-fraction_0.8_relaxation-time-ms_0.2
 
-# shellcheck source=scripts/study_helpers.sh
-source scripts/study_helpers.sh
 study_needles crack_study
 
 csv="$out/crack_study$suffix.csv"

@@ -19,15 +19,15 @@ out="${1:-out/cutting}"
 shift || true
 [ -x build/apps/needle ] || bash scripts/build.sh
 mkdir -p "$out"
+# shellcheck source=scripts/study_helpers.sh
+source scripts/study_helpers.sh
 
 pressures=("$@")
 [ "${#pressures[@]}" -gt 0 ] || pressures=(0 0.1 0.3)
 for p in "${pressures[@]}"; do
-  [[ "$p" =~ ^[0-9]*\.?[0-9]+$ ]] || { echo "cutting_study: '$p' is not a pressure in MPa (a number >= 0, e.g. 0.1)" >&2; exit 2; }
+  study_number cutting_study "'$p'" "$p" ">=0" "a pressure in MPa" 0.1
 done
 
-# shellcheck source=scripts/study_helpers.sh
-source scripts/study_helpers.sh
 study_needles cutting_study
 
 csv="$out/cutting_study.csv"

@@ -18,15 +18,15 @@ out="${1:-out/groove_start}"
 shift || true
 [ -x build/apps/needle ] || bash scripts/build.sh
 mkdir -p "$out"
+# shellcheck source=scripts/study_helpers.sh
+source scripts/study_helpers.sh
 
 starts=("$@")
 [ "${#starts[@]}" -gt 0 ] || starts=(5)
 for g in "${starts[@]}"; do
-  [[ "$g" =~ ^[0-9]*\.?[0-9]+$ ]] && [[ ! "$g" =~ ^0*\.?0*$ ]] || { echo "groove_start_study: '$g' is not a start in mm (a number > 0, e.g. 5)" >&2; exit 2; }
+  study_number groove_start_study "'$g'" "$g" ">0" "a start in mm" 5
 done
 
-# shellcheck source=scripts/study_helpers.sh
-source scripts/study_helpers.sh
 study_needles groove_start_study
 
 csv="$out/groove_start_study.csv"

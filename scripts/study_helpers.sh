@@ -30,6 +30,16 @@ study_run_two_at_once() {
   done
 }
 
+# study_number STUDY SHOWN VALUE SIGN WHAT EXAMPLE: VALUE must be a plain decimal number, > 0 (SIGN ">0") or >= 0 (SIGN ">=0");
+# otherwise one line, "STUDY: SHOWN is not WHAT (a number SIGN, e.g. EXAMPLE)", and exit 2. SHOWN is how the user gave it,
+# e.g. "'0.02'" for an argument or "K='x'" for a variable.
+study_number() {
+  local study="$1" shown="$2" value="$3" sign="$4" what="$5" example="$6" ok=1
+  [[ "$value" =~ ^[0-9]*\.?[0-9]+$ ]] || ok=0
+  [ "$sign" != ">0" ] || [[ ! "$value" =~ ^0*\.?0*$ ]] || ok=0
+  [ "$ok" = 1 ] || { echo "$study: $shown is not $what (a number ${sign%0} 0, e.g. $example)" >&2; exit 2; }
+}
+
 # study_needles STUDY: the NEEDLES the study runs (default "SB AMB") into the array `needles`; SB must be among them, since
 # the ratios are to SB (one line and exit 2 otherwise).
 study_needles() {
