@@ -27,10 +27,11 @@ Scene default_run_scene();
 void run_insertion(const Scene& scene, const RunOptions& options);
 
 // Runs the scene into options.out_dir unless that folder already holds a run (summary.json) of exactly
-// this scene (scene.json); true if it reused one. An interrupted `paper` or `calibrate` resumes this way.
+// this scene (scene.json, threads aside); true if it reused one. An interrupted `paper` or `calibrate` resumes this way.
 bool run_insertion_unless_done(const Scene& scene, const RunOptions& options);
 
-// Whether folder holds a run (summary.json, finished or stopped) of exactly this scene (scene.json).
+// Whether folder holds a run (summary.json, finished or stopped) of exactly this scene (scene.json), whatever
+// worker threads it ran on (solver.threads, which does not change a run's results).
 bool folder_holds_run_of(const Scene& scene, const std::string& folder);
 
 // The scene flags `needle run`, `paper` and `calibrate` share; NaN keeps the scene's value.

@@ -1,6 +1,6 @@
 // `needle calibrate` over run folders written here with known deflections: every E it asks for is already
 // there, so it runs nothing. A run of the same scene at another E, already in OUT/runs, gives the slope
-// d delta / d E without a sensitivity run; a run of another scene there is passed over.
+// d delta / d E without a sensitivity run, whatever threads it ran on; a run of another scene there is passed over.
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <fmt/format.h>
@@ -17,10 +17,12 @@ using needle_test::run;
 
 namespace {
 
-// A run folder as `needle calibrate` names and writes it: the scene at E and a finished summary.
-void write_run_at(const fs::path& runs, const needle::Scene& base, double E_MPa, double deflection_mm) {
+// A run folder as `needle calibrate` names and writes it: the scene at E (run on `threads` worker threads) and a
+// finished summary.
+void write_run_at(const fs::path& runs, const needle::Scene& base, double E_MPa, double deflection_mm, int threads = 0) {
   needle::Scene scene = base;
   scene.tissue.material.E_MPa = E_MPa;
+  scene.solver.threads = threads;
   const fs::path folder = runs / fmt::format("E_{:.6g}MPa", E_MPa);
   fs::create_directories(folder);
   std::ofstream(folder / "scene.json") << needle::scene_to_json(scene).dump(2);
@@ -49,7 +51,7 @@ TEST_CASE("needle calibrate takes the slope from a run of the same scene already
   fs::remove_all(dir);
   const fs::path runs = dir / "runs";
   write_run_at(runs, calibration_scene(0.02), 0.080, -1.115);   // the start: within 0.05 of the target
-  write_run_at(runs, calibration_scene(0.02), 0.0748, -1.042);  // an earlier run of the same scene
+  write_run_at(runs, calibration_scene(0.02), 0.0748, -1.042, 2);  // an earlier run of the same scene, on two threads
   write_run_at(runs, calibration_scene(0.04), 0.078, -2.0);     // nearer in E, but another contact: not a partner
   const auto result = run(fmt::format("calibrate --preset SB --target-deflection-mm -1.14 --start-E-MPa 0.08 --travel-mm 4 "
                                       "--contact-skin-mm 0.02 --out {}",
