@@ -469,11 +469,12 @@ void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
                 "The groove's front wall this far behind tip point A. The paper does not give it; the presets' 3 mm clears the SB "
                 "bevel's heel (2.3 mm) (default: the recipe's; scene key needle.groove_start_mm)");
   c->add_option("--contact-skin-mm", o.contact_skin_mm,
-                "The penalty contact's skin: particles feel the needle this far outside its surface, so the needle acts that much "
-                "thicker (a numerical parameter, 0 is exact contact; default 0.04; scene key tissue.contact.skin_mm)");
+                fmt::format("The penalty contact's skin: particles feel the needle this far outside its surface, so the needle acts that much "
+                            "thicker (a numerical parameter, 0 is exact contact; default {:g}; scene key tissue.contact.skin_mm)", ContactOptions{}.skin_mm));
   c->add_option("--contact-stiffness-factor", o.contact_stiffness_factor,
-                "The penalty's stiffness as a multiple of the particle's own (a numerical parameter: stiffer holds particles nearer "
-                "the skin and takes more tissue steps; default 10; scene key tissue.contact.stiffness_factor)");
+                fmt::format("The penalty's stiffness as a multiple of the particle's own (a numerical parameter: stiffer holds particles nearer "
+                            "the skin and takes more tissue steps; default {:g}; scene key tissue.contact.stiffness_factor)",
+                            ContactOptions{}.stiffness_factor));
 }
 
 std::string scene_override_arguments(const SceneOverrides& o) {

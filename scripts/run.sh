@@ -25,15 +25,17 @@ done
 ./build/bench/bench_needle | tee out/bench_needle.txt
 ./build/bench/bench_insertion | tee out/bench_insertion.txt
 # The paper reproduced: SB, LMB, AMB and HMB on the paper's scene with the tissue E calibrated on SB
-# (data/paper/calibration_sb.json, made by `needle calibrate`; docs/paper.md), about 25 minutes a needle
+# (data/paper/calibration_sb.json, made by `needle calibrate`; docs/paper.md), about 40 minutes a needle
 # on 2 cores. A run the solver stops is reported as such in the report, not an error of the main job.
-# The report sets three other models beside it, from their stored reports in docs/paper_results/: the
-# same particles without the needle's cut, the paper's 0.4 mm particles with it, and the tissue law
-# that stiffens as the paper's measured curve, calibrated on SB (docs/paper.md).
-./build/apps/needle paper --calibration data/paper/calibration_sb.json --out out/paper --label "cut, 0.2 mm near the path" \
-  --compare "no cut, 0.2 mm near the path=docs/paper_results/no_cut/results.json" \
-  --compare "cut, 0.4 mm (the paper's spacing)=docs/paper_results/particles_0.4mm/results.json" \
-  --compare "stiffening law, calibrated on SB=docs/paper_results/stiffening_calibrated/results.json"
+# The report sets five other models beside it, from their stored reports in docs/paper_results/: the
+# contact's former default (skin 0.04 mm, factor 10), skin 0.02 mm at factor 10, the groove 5 mm behind
+# the tip point, the tissue law that stiffens as the paper's measured curve, and no cut (docs/paper.md).
+./build/apps/needle paper --calibration data/paper/calibration_sb.json --out out/paper --label "cut, 0.2 mm near the path, skin 0.02 mm" \
+  --compare "skin 0.04 mm, factor 10 (the default before), E 0.0748=docs/paper_results/skin0.04_k10/results.json" \
+  --compare "skin 0.02 mm, factor 10, calibrated (E 0.080)=docs/paper_results/skin0.02_calibrated/results.json" \
+  --compare "groove 5 mm behind A, skin 0.04 mm, calibrated (E 0.0493)=docs/paper_results/groove5_calibrated/results.json" \
+  --compare "stiffening law, skin 0.04 mm, calibrated on SB=docs/paper_results/stiffening_calibrated/results.json" \
+  --compare "no cut, skin 0.04 mm, E 0.0748=docs/paper_results/no_cut/results.json"
 echo "results in out/: <preset>.json (report), <preset>.stl, <preset>_half.glb, <preset>.png,"
 echo "  <preset>_half_t10.msh/.vtu + <preset>_mesh.json (T10 mesh and its report), tissue_particles.vtp/.json,"
 echo "  material_test.csv/.png/.json (the tissue card in uniaxial tension), stiffness_<preset>.json (tip compliance"

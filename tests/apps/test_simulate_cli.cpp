@@ -401,17 +401,17 @@ TEST_CASE("needle run --hold-ms: the base stops at the travel's end, the drive d
 TEST_CASE("needle run --tissue-size-mm: the lattice fills the given block, and fixed faces further out hold the tissue less stiffly",
           "[apps][lspg][gmsh]") {
   // The lattice has round(size / 0.4) + 1 nodes per axis. The same rod pushed into a block whose fixed faces (y = +-Y/2, z = Z)
-  // stand further from it meets tissue that is less confined: it stores less strain energy and drags the rod less.
+  // stand further from it meets tissue that is less confined: it stores less strain energy at every sample of the run.
+  // (The rod's drag is not compared: on a lattice six particles long, the contact force of one sample swings by a
+  // factor of 40 between samples as single particles enter and leave the skin.)
   struct Block {
     long particles;
-    double internal_mJ, drag_N;
+    std::vector<double> internal_mJ;
   };
   auto push_into = [](const std::string& name, const std::string& size_flag) {
     const RunFiles run = run_rod_into_small_block(name, size_flag);
     CHECK(run.summary["status"] == "finished");
-    return std::pair{run.scene["tissue"]["size_mm"],
-                     Block{run.summary["particles"].get<long>(), run.history.column("tissue_internal_mJ").back(),
-                           std::abs(run.history.column("contact_force_x_N").back())}};
+    return std::pair{run.scene["tissue"]["size_mm"], Block{run.summary["particles"].get<long>(), run.history.column("tissue_internal_mJ")}};
   };
   const auto [narrow_size, narrow] = push_into("size_narrow", "");
   const auto [wide_size, wide] = push_into("size_wide", "--tissue-size-mm 2,4,2.4");
@@ -419,11 +419,13 @@ TEST_CASE("needle run --tissue-size-mm: the lattice fills the given block, and f
   CHECK(wide_size == nlohmann::json::array({2.0, 4.0, 2.4}));
   CHECK(narrow.particles == 6 * 7 * 4);
   CHECK(wide.particles == 6 * 11 * 7);
-  INFO("strain energy narrow " << narrow.internal_mJ << " mJ, wide " << wide.internal_mJ << " mJ; drag narrow " << narrow.drag_N
-                               << " N, wide " << wide.drag_N << " N");
-  CHECK(wide.internal_mJ > 0);
-  CHECK(wide.internal_mJ < narrow.internal_mJ);
-  CHECK(wide.drag_N < narrow.drag_N);
+  REQUIRE(narrow.internal_mJ.size() == wide.internal_mJ.size());
+  REQUIRE(narrow.internal_mJ.size() >= 5);
+  for (size_t i = 1; i < narrow.internal_mJ.size(); ++i) {  // row 0 is the start, before the rod touches the block
+    INFO("sample " << i << ": strain energy narrow " << narrow.internal_mJ[i] << " mJ, wide " << wide.internal_mJ[i] << " mJ");
+    CHECK(wide.internal_mJ[i] > 0);
+    CHECK(wide.internal_mJ[i] < narrow.internal_mJ[i]);
+  }
 
   refused_on_small_block("size_bad", "--tissue-size-mm 2,0,1.2", "--tissue-size-mm must be three positive lengths x,y,z (got 2,0,1.2)");
 }
@@ -617,28 +619,30 @@ TEST_CASE("needle run --groove-start-mm: the scene says so, the built needle's g
 TEST_CASE("needle run --contact-skin-mm, --contact-stiffness-factor: the scene says so, the solver feels both, bad input is refused",
           "[apps][lspg][gmsh][contact]") {
   // The penalty contact's two numerical parameters (solver/needle_tissue_contact.h). The skin holds the particles off the
-  // needle's true surface: without it they sink into the rod until the penalty holds them, with a thin one less, with the
-  // default 0.04 mm hardly at all (the rod pushed 0.8 mm in). The tissue's step is capped by the contact's own stable step,
-  // which goes as 1 / sqrt(k): three times the stiffness takes about sqrt(3) times the steps.
+  // needle's true surface: at stiffness factor 10, without it they sink into the rod until the penalty holds them, with a
+  // thin one less, with a thick one (0.04 mm, the default before the skin study) hardly at all (the rod pushed 0.8 mm in).
+  // The tissue's step is capped by the contact's own stable step, which goes as 1 / sqrt(k): the default's three times
+  // the stiffness of factor 10 takes about sqrt(3) times the steps.
   const RunFiles defaults = run_rod_into_small_block("contact_default", "");
-  const RunFiles exact = run_rod_into_small_block("contact_skin0", "--contact-skin-mm 0");
-  const RunFiles thin = run_rod_into_small_block("contact_skin0.02", "--contact-skin-mm 0.02");
-  const RunFiles stiff = run_rod_into_small_block("contact_k30", "--contact-stiffness-factor 30");
-  CHECK(defaults.scene["tissue"]["contact"]["skin_mm"].get<double>() == 0.04);
+  const RunFiles exact = run_rod_into_small_block("contact_skin0", "--contact-skin-mm 0 --contact-stiffness-factor 10");
+  const RunFiles thin = run_rod_into_small_block("contact_skin0.02", "--contact-skin-mm 0.02 --contact-stiffness-factor 10");
+  const RunFiles thick = run_rod_into_small_block("contact_skin0.04", "--contact-skin-mm 0.04 --contact-stiffness-factor 10");
+  CHECK(defaults.scene["tissue"]["contact"]["skin_mm"].get<double>() == 0.02);
+  CHECK(defaults.scene["tissue"]["contact"]["stiffness_factor"].get<double>() == 30.0);
   CHECK(exact.scene["tissue"]["contact"]["skin_mm"].get<double>() == 0.0);
-  CHECK(thin.scene["tissue"]["contact"]["skin_mm"].get<double>() == 0.02);
-  CHECK(stiff.scene["tissue"]["contact"]["stiffness_factor"].get<double>() == 30.0);
+  CHECK(thick.scene["tissue"]["contact"]["skin_mm"].get<double>() == 0.04);
+  CHECK(thin.scene["tissue"]["contact"]["stiffness_factor"].get<double>() == 10.0);
   const double depth_exact = exact.summary["max_penetration_mm"].get<double>();
   const double depth_thin = thin.summary["max_penetration_mm"].get<double>();
-  const double depth_default = defaults.summary["max_penetration_mm"].get<double>();
-  const double steps_ratio = stiff.summary["steps"].get<double>() / defaults.summary["steps"].get<double>();
-  INFO("deepest particle below the rod's surface at skin 0 / 0.02 / 0.04 mm: " << depth_exact << " / " << depth_thin << " / " << depth_default
+  const double depth_thick = thick.summary["max_penetration_mm"].get<double>();
+  const double steps_ratio = defaults.summary["steps"].get<double>() / thin.summary["steps"].get<double>();
+  INFO("deepest particle below the rod's surface at skin 0 / 0.02 / 0.04 mm: " << depth_exact << " / " << depth_thin << " / " << depth_thick
                                                                                << " mm; steps at stiffness 30 over 10: " << steps_ratio);
   CHECK(depth_exact > depth_thin);
-  CHECK(depth_thin > depth_default);
+  CHECK(depth_thin > depth_thick);
   CHECK(depth_exact > 0.01);
   CHECK(steps_ratio == Approx(std::sqrt(3.0)).epsilon(0.15));
-  for (const RunFiles* r : {&exact, &thin, &stiff}) {
+  for (const RunFiles* r : {&defaults, &exact, &thin, &thick}) {
     CHECK(r->summary["status"] == "finished");
     CHECK(r->summary["energy_balance_error"].get<double>() < 0.02);
   }
