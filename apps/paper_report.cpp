@@ -110,7 +110,7 @@ NeedleRun read_run(const std::string& out_dir, const std::string& name) {
         const double lead_mm = contact.value("crack_lead_mm", 0.0);
         if (lead_mm > 0) r.model_description += fmt::format(", running {:g} mm ahead of the tip", lead_mm);
       }
-      // The default contact (skin 0.04 mm, stiffness factor 10) goes unnamed; another is said.
+      // The default contact (ContactOptions: skin 0.02 mm, stiffness factor 30) goes unnamed; another is said.
       const ContactOptions default_contact;
       const double skin_mm = contact.value("skin_mm", default_contact.skin_mm);
       const double stiffness_factor = contact.value("stiffness_factor", default_contact.stiffness_factor);

@@ -7,8 +7,8 @@
 # (docs/paper.md).
 #
 #   scripts/contact_study.sh [OUT] [SKIN_mm...]
-#       default: out/contact, skins 0.02; the default model's 0.04 comes from the spacing study
-#   K=30 scripts/contact_study.sh ...                             (the stiffness factor; default 10, the run default)
+#       default: out/contact, skins 0.02; the 0.04 of the study scene comes from the spacing study
+#   K=30 scripts/contact_study.sh ...                             (the stiffness factor; default 10, the 10 mm study scene's; the run default is 30)
 #   NEEDLES="SB LMB AMB HMB" scripts/contact_study.sh ...          (default NEEDLES="SB AMB"; SB must be among them)
 #
 # Two runs at once (one core each). A finished run (OUT/<needle>_s<skin>_k<K>/summary.json) is kept, so an interrupted study
@@ -45,5 +45,5 @@ done
 mv "$csv.partial" "$csv"
 
 ratio_table "$csv" "skin (mm), K $k"
-echo "the default contact, skin 0.04 mm and K 10 (docs/paper_results/spacing_study_10mm.csv): SB -0.212, LMB +0.045, AMB +0.355, HMB +0.647 mm"
+echo "the study scene's contact (the run default until 2026-11-24), skin 0.04 mm and K 10 (docs/paper_results/spacing_study_10mm.csv): SB -0.212, LMB +0.045, AMB +0.355, HMB +0.647 mm"
 echo "table: $csv; runs in $out/<needle>_s<skin>_k$k"
