@@ -18,6 +18,7 @@
 
 #include "apps/calibration_steps.h"
 #include "apps/insertion_run.h"
+#include "apps/scene_overrides.h"
 #include "apps/json_file.h"
 #include "apps/scene.h"
 #include "geometry/input_error.h"

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "apps/insertion_run.h"
+#include "apps/scene_overrides.h"
 #include "apps/json_file.h"
 #include "apps/paper_report.h"
 #include "apps/scene.h"

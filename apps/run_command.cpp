@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "apps/insertion_run.h"
+#include "apps/scene_overrides.h"
 #include "apps/scene.h"
 #include "geometry/input_error.h"
 

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/insertion_run.h"
+#include "apps/scene_overrides.h"
 #include "apps/scene.h"
 #include "cli_run.h"
 
