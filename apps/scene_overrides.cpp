@@ -85,6 +85,12 @@ void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
     NEEDLE_REQUIRE(o.contact_stiffness_factor <= 1e4, fmt::format("--contact-stiffness-factor must be at most 1e4 (got {})", o.contact_stiffness_factor));
     scene.tissue.contact.stiffness_factor = o.contact_stiffness_factor;
   }
+  if (given_or_zero(o.tissue_entry_x_mm, "--tissue-entry-x-mm")) {
+    NEEDLE_REQUIRE(o.tissue_entry_x_mm < scene.motion.travel_mm,
+                   fmt::format("--tissue-entry-x-mm must be less than the travel ({} mm), or the tip never reaches the tissue (got {})",
+                               scene.motion.travel_mm, o.tissue_entry_x_mm));
+    scene.tissue.entry_x_mm = o.tissue_entry_x_mm;
+  }
 }
 
 void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
@@ -149,6 +155,11 @@ void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
                 fmt::format("The penalty's stiffness as a multiple of the particle's own (a numerical parameter: stiffer holds particles nearer "
                             "the skin and takes more tissue steps; default {:g}; scene key tissue.contact.stiffness_factor)",
                             ContactOptions{}.stiffness_factor));
+  c->add_option("--tissue-entry-x-mm", o.tissue_entry_x_mm,
+                "The block's entry face this far ahead of tip point A's start (default 0: at the cannula's front). The particle "
+                "lattice starts at the entry face, so a fraction of the spacing (e.g. 0.1 at 0.2 mm particles) shifts the lattice "
+                "against the needle's path: the run-to-run scatter of a result is measured so (the tip then ends that much less "
+                "deep in the tissue; scene key tissue.entry_x_mm)");
 }
 
 std::string scene_override_arguments(const SceneOverrides& o) {
@@ -175,6 +186,7 @@ std::string scene_override_arguments(const SceneOverrides& o) {
   if (!std::isnan(o.groove_start_mm)) line += fmt::format(" --groove-start-mm {}", o.groove_start_mm);
   if (!std::isnan(o.contact_skin_mm)) line += fmt::format(" --contact-skin-mm {}", o.contact_skin_mm);
   if (!std::isnan(o.contact_stiffness_factor)) line += fmt::format(" --contact-stiffness-factor {}", o.contact_stiffness_factor);
+  if (!std::isnan(o.tissue_entry_x_mm)) line += fmt::format(" --tissue-entry-x-mm {}", o.tissue_entry_x_mm);
   return line;
 }
 

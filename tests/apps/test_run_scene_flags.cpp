@@ -352,3 +352,40 @@ TEST_CASE("needle run --contact-skin-mm, --contact-stiffness-factor: the scene s
     CHECK(std::count(out.begin(), out.end(), '\n') == 1);
   }
 }
+
+TEST_CASE("needle run --tissue-entry-x-mm: the block starts there, the rod meets no tissue before it, bad input is refused",
+          "[apps][lspg][gmsh][contact]") {
+  // The flag that shifts the particle lattice against the needle's path (the lattice starts at the entry face), so that a
+  // result's run-to-run scatter can be measured. The same block, moved 0.2 mm ahead of the rod's start: the same particles,
+  // no contact and no broken bond while the rod's end is short of the face by more than the contact's skin, and the rod's
+  // 0.6 mm in the tissue instead of 0.8 cut fewer bonds and strain the block less.
+  const RunFiles at_face = run_rod_into_small_block("entry_0", "");
+  const RunFiles ahead = run_rod_into_small_block("entry_0.2", "--tissue-entry-x-mm 0.2");
+  CHECK(at_face.scene["tissue"]["entry_x_mm"].get<double>() == 0.0);
+  CHECK(ahead.scene["tissue"]["entry_x_mm"].get<double>() == 0.2);
+  CHECK(ahead.summary["particles"] == at_face.summary["particles"]);
+  const double skin_mm = ahead.scene["tissue"]["contact"]["skin_mm"].get<double>();
+  const auto insertion = ahead.history.column("insertion_mm"), contacts = ahead.history.column("particles_in_contact"),
+             broken = ahead.history.column("bonds_broken");
+  int rows_short_of_face = 0;
+  for (size_t i = 0; i < insertion.size(); ++i)
+    if (insertion[i] < 0.2 - skin_mm) {
+      ++rows_short_of_face;
+      CHECK(contacts[i] == 0);
+      CHECK(broken[i] == 0);
+    }
+  CHECK(rows_short_of_face >= 2);
+  // At the face the rod starts touching the entry face's particles.
+  CHECK(at_face.history.column("bonds_broken")[1] > 0);
+  INFO("bonds cut at entry 0 / 0.2 mm: " << at_face.summary["bonds_cut_by_needle"] << " / " << ahead.summary["bonds_cut_by_needle"]);
+  CHECK(ahead.summary["bonds_cut_by_needle"].get<int>() < at_face.summary["bonds_cut_by_needle"].get<int>());
+  CHECK(ahead.summary["energy_mJ"]["tissue_internal"].get<double>() < at_face.summary["energy_mJ"]["tissue_internal"].get<double>());
+  for (const RunFiles* r : {&at_face, &ahead}) CHECK(r->summary["status"] == "finished");
+
+  // A negative entry, or one the travel never reaches: one line, exit 2, no run folder.
+  for (const auto& [flags, message] : {std::pair<std::string, std::string>{"--tissue-entry-x-mm -0.1", "--tissue-entry-x-mm must be a number >= 0"},
+                                       {"--tissue-entry-x-mm 0.8", "--tissue-entry-x-mm must be less than the travel"}}) {
+    const std::string out = refused_on_small_block("entry_bad", flags, message);
+    CHECK(std::count(out.begin(), out.end(), '\n') == 1);
+  }
+}
