@@ -22,10 +22,10 @@ const NeedleOutcome* find_run(const std::vector<NeedleOutcome>& runs, const std:
 
 }  // namespace
 
-ComparedModel parse_compared_model(const std::string& text) {
+ComparedModel parse_compared_model(const std::string& text, const char* flag) {
   const auto eq = text.find('=');
   NEEDLE_REQUIRE(eq != std::string::npos && eq > 0 && eq + 1 < text.size(),
-                 fmt::format("--compare '{}': give LABEL=FILE, e.g. \"0.4 mm, cut=paper_04/results.json\"", text));
+                 fmt::format("{} '{}': give LABEL=FILE, e.g. \"0.4 mm, cut=paper_04/results.json\"", flag, text));
   return {text.substr(0, eq), text.substr(eq + 1)};
 }
 

@@ -16,8 +16,8 @@ struct ComparedModel {
   std::string label, results_path;
 };
 
-// "LABEL=FILE" -> its parts; InputError for a missing label or file name.
-ComparedModel parse_compared_model(const std::string& text);
+// "LABEL=FILE" -> its parts; InputError naming the flag for a missing label or file name.
+ComparedModel parse_compared_model(const std::string& text, const char* flag = "--compare");
 
 // A model's report: this one's runs, or another's read back from its results.json.
 struct ModelResults {

@@ -9,6 +9,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <tuple>
 
 #include "apps/insertion_run.h"
 #include "apps/scene_overrides.h"
@@ -31,6 +32,7 @@ struct PaperOptions {
   std::string out_dir, needles = "SB,LMB,AMB,HMB", reference = std::string(NEEDLE_DATA_DIR) + "/paper/reference.json";
   std::string calibration_file;
   std::vector<std::string> compare;  // LABEL=FILE, other reports' results.json
+  std::vector<std::string> replicas;  // LABEL=FILE, this model's reports with a numerical detail changed
   std::string label = "this report";  // this report's row among the compared models
   double tissue_E_MPa = std::nan("");
   SceneOverrides overrides;
@@ -75,12 +77,13 @@ void paper(const PaperOptions& o) {
   }
   scene.tissue.material.validate();
   apply_scene_overrides(scene, o.overrides);
-  std::vector<ComparedModel> compare;
-  for (const std::string& c : o.compare) {
-    compare.push_back(parse_compared_model(c));
-    NEEDLE_REQUIRE(fs::is_regular_file(compare.back().results_path),
-                   fmt::format("--compare {}: no file '{}'", compare.back().label, compare.back().results_path));
-  }
+  std::vector<ComparedModel> compare, replicas;
+  for (const auto& [texts, flag, models] : {std::tuple{&o.compare, "--compare", &compare}, std::tuple{&o.replicas, "--replica", &replicas}})
+    for (const std::string& c : *texts) {
+      models->push_back(parse_compared_model(c, flag));
+      NEEDLE_REQUIRE(fs::is_regular_file(models->back().results_path),
+                     fmt::format("{} {}: no file '{}'", flag, models->back().label, models->back().results_path));
+    }
 
   const fs::path dir(o.out_dir);
   const fs::path parent = fs::absolute(dir).parent_path();
@@ -143,6 +146,7 @@ void paper(const PaperOptions& o) {
   report.command_line = o.command_line;
   report.draw_tips = !o.no_tips;
   report.compare = compare;
+  report.replicas = replicas;
   report.label = o.label;
   write_paper_report(report);
   if (!o.quiet) fmt::print("wrote {}\n", (dir / "report.md").string());
@@ -164,6 +168,10 @@ void add_paper_command(CLI::App& app) {
   c->add_option("--compare", o->compare,
                 "LABEL=FILE: set another report's results.json (another model: spacing, cut, E) beside this one in the report; "
                 "repeatable");
+  c->add_option("--replica", o->replicas,
+                "LABEL=FILE: the results.json of a report of this same model whose runs differ only in a numerical detail, e.g. "
+                "--tissue-entry-x-mm 0.1 (the lattice shifted against the path); the report gives each deflection's spread over "
+                "the replicas and which targets hold in every one (scripts/scatter_study.sh); repeatable");
   c->add_option("--label", o->label, "This report's name in the table of --compare (default 'this report')");
   c->add_flag("--report-only", o->report_only, "Only rewrite the report from the run folders already in OUT/runs");
   c->add_flag("--rerun", o->rerun, "Run every needle again even if OUT/runs holds a run of the same scene");
@@ -181,6 +189,7 @@ void add_paper_command(CLI::App& app) {
     line += scene_override_arguments(o->overrides);
     if (c->count("--label")) line += fmt::format(" --label \"{}\"", o->label);
     for (const std::string& c : o->compare) line += fmt::format(" --compare \"{}\"", c);
+    for (const std::string& c : o->replicas) line += fmt::format(" --replica \"{}\"", c);
     paper(*o);
   });
 }

@@ -300,6 +300,9 @@ void write_paper_report(const PaperReportInput& in) {
     models.push_back(self);
     for (const ComparedModel& c : in.compare) models.push_back(read_model_results(c));
   }
+  std::vector<ModelResults> replicas;
+  for (const ComparedModel& c : in.replicas) replicas.push_back(read_model_results(c));
+  const ReplicaScatter scatter = replica_scatter(outcomes, replicas, in.reference);
 
   // results.json
   json needles = json::object();
@@ -316,6 +319,11 @@ void write_paper_report(const PaperReportInput& in) {
               {"bonds_cut_by_needle", r.bonds_cut_by_needle},
               {"run_folder", fs::relative(r.folder, dir).string()}};
     if (!r.reason.empty()) n["reason"] = r.reason;
+    for (const NeedleScatter& s : scatter.needles)
+      if (s.name == r.name && s.replicas_with_needle > 0) {
+        n["deflection_spread_mm"] = s.spread_mm;
+        n["replicas_with_needle"] = s.replicas_with_needle;
+      }
     if (const PaperReferenceNeedle* ref = find_reference(in.reference, r.name)) {
       n["deflection_experiment_mm"] = ref->deflection_experiment_mm;
       n["deflection_lsdyna_mm"] = ref->deflection_lsdyna_mm;
@@ -325,8 +333,13 @@ void write_paper_report(const PaperReportInput& in) {
     needles[r.name] = n;
   }
   json target_list = json::array();
-  for (const PaperTarget& t : targets) target_list.push_back({{"target", t.what}, {"numbers", t.numbers}, {"met", t.met}, {"checked", t.checked}});
-  const json results = {{"needles", needles},
+  for (size_t i = 0; i < targets.size(); ++i) {
+    const PaperTarget& t = targets[i];
+    json target = {{"target", t.what}, {"numbers", t.numbers}, {"met", t.met}, {"checked", t.checked}};
+    if (!replicas.empty()) target["replicas"] = {{"checked", scatter.targets[i].checked}, {"met", scatter.targets[i].met}};
+    target_list.push_back(target);
+  }
+  json results = {{"needles", needles},
                         {"tissue_E_MPa", in.tissue_E_MPa},
                         {"tissue_E_source", in.tissue_E_source},
                         {"groove_fill_definition",
@@ -335,6 +348,7 @@ void write_paper_report(const PaperReportInput& in) {
                         {"targets", target_list},
                         {"tissue", tissue},
                         {"reference", fs::proximate(in.reference_path).string()}};
+  for (const ModelResults& m : replicas) results["replicas"].push_back({{"label", m.label}, {"results", m.path}});
 
   // The pictures.
   save_png(deflection_plot(runs, in.reference), (dir / "deflection_vs_insertion.png").string());
@@ -406,6 +420,7 @@ void write_paper_report(const PaperReportInput& in) {
   md += "## The paper's targets\n\n| target | numbers | verdict |\n|---|---|---|\n";
   for (const PaperTarget& t : targets)
     md += fmt::format("| {} | {} | {} |\n", t.what, t.numbers, !t.checked ? "not checked (missing run)" : t.met ? "met" : "**not met**");
+  if (!replicas.empty()) md += "\n" + replica_section(scatter, replicas, targets);
   if (!models.empty()) md += "\n" + models_section(models, in.needles, in.reference);
   md += models.empty() ? "\n## Groove filling\n\n" : "## Groove filling\n\n";
   md += "`groove_fill`: at the end of insertion, in the needle's own frame (each particle pulled back through the needle "

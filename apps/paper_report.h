@@ -10,12 +10,15 @@
 //   facet_forces.png             the y force on each tip facet against insertion, one panel per needle;
 //   tips.png                     the four tips, from above and below;
 //   models.png                   with compared models: delta of each model, the experiment and LS-DYNA.
+// With replicas the report and results.json also give each deflection's run-to-run scatter and the targets
+// in the replicas.
 // Every file is written whole or not at all.
 #include <string>
 #include <vector>
 
 #include "apps/model_comparison.h"
 #include "apps/paper_results.h"
+#include "apps/run_replicas.h"
 
 namespace needle {
 
@@ -30,6 +33,7 @@ struct PaperReportInput {
   std::string command_line;                // to regenerate
   bool draw_tips = true;
   std::vector<ComparedModel> compare;      // other models' results.json, in the order to show
+  std::vector<ComparedModel> replicas;     // this model's runs repeated with a numerical detail changed (apps/run_replicas.h)
   std::string label = "this report";       // this report's model among them
 };
 

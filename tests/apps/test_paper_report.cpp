@@ -276,3 +276,56 @@ TEST_CASE("Compared models get colours of their own, never the experiment's or L
   }
   CHECK(needle::compared_model_colour(0) == needle::kOurs);
 }
+
+TEST_CASE("needle paper --replica gives each deflection's spread over replicas of the same model and the targets that hold in each",
+          "[apps][paper]") {
+  // This report meets LMB's target by 0.07 mm. Replica A (SB and LMB, e.g. the lattice shifted) puts LMB 0.17 mm off and above
+  // AMB + 0.1 (the order fails); replica B (LMB alone) meets it. Spreads: SB |-1.10 - -1.12| = 0.02, LMB 0.32 - 0.18 = 0.14.
+  const fs::path dir = fresh("replica_this"), a = fresh("replica_a"), b = fresh("replica_b");
+  const std::map<std::string, FakeRun> runs = {{"SB", {-1.10, 0.90}}, {"LMB", {0.22, 0.95}}, {"AMB", {0.20, 0.40}}, {"HMB", {1.20, 0.10}}};
+  for (const auto& [name, r] : runs) write_run(dir, name, r);
+  write_run(a, "SB", {-1.12, 0.90});
+  write_run(a, "LMB", {0.32, 0.95});
+  write_run(b, "LMB", {0.18, 0.95});
+  REQUIRE(run("paper --report-only --no-tips --quiet --tissue-E-MPa 0.05 --needles SB,LMB --out " + a.string(), true).exit_code == 0);
+  REQUIRE(run("paper --report-only --no-tips --quiet --tissue-E-MPa 0.05 --needles LMB --out " + b.string(), true).exit_code == 0);
+
+  // A bad --replica is refused before anything is written.
+  auto bad = run("paper --report-only --no-tips --quiet --out " + dir.string() + " --replica " + (a / "results.json").string(), true);
+  CHECK(bad.exit_code == 2);
+  CHECK(bad.out.find("--replica '") != std::string::npos);
+  CHECK(bad.out.find("give LABEL=FILE") != std::string::npos);
+  bad = run("paper --report-only --no-tips --quiet --out " + dir.string() + " --replica A=/nonexistent/results.json", true);
+  CHECK(bad.exit_code == 2);
+  CHECK(bad.out.find("--replica A: no file '/nonexistent/results.json'") != std::string::npos);
+  CHECK(!fs::exists(dir / "report.md"));
+
+  const auto result = run("paper --report-only --no-tips --quiet --tissue-E-MPa 0.05 --out " + dir.string() + " --replica \"A=" +
+                              (a / "results.json").string() + "\" --replica \"B=" + (b / "results.json").string() + "\"",
+                          true);
+  INFO(result.out);
+  REQUIRE(result.exit_code == 0);
+  const std::string md = read_text(dir / "report.md");
+  INFO(md);
+  CHECK(md.find("## Run-to-run scatter: the same model in replicas") != std::string::npos);
+  CHECK(md.find("| needle | this report | A | B | spread (max - min, mm) |") != std::string::npos);
+  CHECK(md.find("| SB | -1.100 | -1.120 | | 0.020 |") != std::string::npos);
+  CHECK(md.find("| LMB | +0.220 | +0.320 | +0.180 | 0.140 |") != std::string::npos);
+  CHECK(md.find("| AMB | +0.200 | | | n/a (no replica) |") != std::string::npos);
+  // Here every target is met; in the replicas the order and LMB fail in A, SB holds in A, the rest are not touched.
+  CHECK(md.find("| sign and order: SB < 0 < LMB <~ AMB < HMB (<~: within 0.1 mm) | met | **met in 1 of 2** (not in: A) |") != std::string::npos);
+  CHECK(md.find("| SB: abs(delta - delta_experiment) <= 0.1 mm | met | met in all 1 |") != std::string::npos);
+  CHECK(md.find("| LMB: abs(delta - delta_experiment) <= 0.1 mm | met | **met in 1 of 2** (not in: A) |") != std::string::npos);
+  CHECK(md.find("| AMB: abs(delta - delta_experiment) <= 0.1 mm | met | the same in every replica") != std::string::npos);
+  CHECK(md.find("--replica \"A=") != std::string::npos);  // the regenerate line keeps them
+
+  const json results = read_json(dir / "results.json");
+  CHECK(results["needles"]["SB"]["deflection_spread_mm"].get<double>() == Approx(0.02));
+  CHECK(results["needles"]["LMB"]["deflection_spread_mm"].get<double>() == Approx(0.14));
+  CHECK(results["needles"]["LMB"]["replicas_with_needle"].get<int>() == 2);
+  CHECK(!results["needles"]["AMB"].contains("deflection_spread_mm"));
+  CHECK(results["targets"][2]["replicas"]["checked"].get<int>() == 2);
+  CHECK(results["targets"][2]["replicas"]["met"].get<int>() == 1);
+  CHECK(results["replicas"].size() == 2);
+  CHECK(results["replicas"][1]["label"] == "B");
+}
