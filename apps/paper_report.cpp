@@ -122,6 +122,12 @@ NeedleRun read_run(const std::string& out_dir, const std::string& name) {
       if (cutting_MPa > 0)
         r.model_description += fmt::format("; cutting the tissue costs work: a pressure of {:g} MPa on the tip facets that advance into it",
                                            cutting_MPa);
+      // The block's entry face at the tip's start is the default and goes unnamed; a shifted one is said.
+      const double entry_x_mm = t.value("entry_x_mm", 0.0);
+      if (entry_x_mm != 0)
+        r.model_description += fmt::format("; the block's entry face is {:g} mm ahead of the tip's start (the particle lattice shifted "
+                                           "against the path; the tip ends that much less deep)",
+                                           entry_x_mm);
     }
     // The paper's drive (8 m/s, read at full speed) goes unnamed; another speed, a stop or a hold is said.
     const InsertionProfile paper_drive;
@@ -418,8 +424,15 @@ void write_paper_report(const PaperReportInput& in) {
   }
   md += "\n![deflection against insertion](deflection_vs_insertion.png)\n\n![deflection bars](deflection_bars.png)\n\n";
   md += "## The paper's targets\n\n| target | numbers | verdict |\n|---|---|---|\n";
-  for (const PaperTarget& t : targets)
-    md += fmt::format("| {} | {} | {} |\n", t.what, t.numbers, !t.checked ? "not checked (missing run)" : t.met ? "met" : "**not met**");
+  for (size_t i = 0; i < targets.size(); ++i) {
+    const PaperTarget& t = targets[i];
+    std::string verdict = !t.checked ? "not checked (missing run)" : t.met ? "met" : "**not met**";
+    // A target met here but not in a replica of the same model is met by chance: the verdict says so.
+    if (t.met && !replicas.empty() && scatter.targets[i].met < scatter.targets[i].checked)
+      verdict = fmt::format("met here, **not in {} of {} replicas** (run-to-run scatter below)",
+                            scatter.targets[i].checked - scatter.targets[i].met, scatter.targets[i].checked);
+    md += fmt::format("| {} | {} | {} |\n", t.what, t.numbers, verdict);
+  }
   if (!replicas.empty()) md += "\n" + replica_section(scatter, replicas, targets);
   if (!models.empty()) md += "\n" + models_section(models, in.needles, in.reference);
   md += models.empty() ? "\n## Groove filling\n\n" : "## Groove filling\n\n";

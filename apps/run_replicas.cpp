@@ -86,11 +86,11 @@ std::string replica_section(const ReplicaScatter& scatter, const std::vector<Mod
     const TargetInReplicas& r = scatter.targets[i];
     std::string verdict = "the same in every replica (none ran its needles, or all got its numbers)";
     if (r.checked > 0)
-      verdict = r.met == r.checked ? fmt::format("met in all {}", r.checked)
+      verdict = r.met == r.checked ? fmt::format("met in {} of {}", r.met, r.checked)
                                    : fmt::format("**met in {} of {}** (not in: {})", r.met, r.checked, fmt::join(r.not_met, "; "));
     md += fmt::format("| {} | {} | {} |\n", t.what, !t.checked ? "not checked" : t.met ? "met" : "not met", verdict);
   }
-  return md + "\n";
+  return md;
 }
 
 }  // namespace needle
