@@ -346,14 +346,14 @@ void write_paper_report(const PaperReportInput& in) {
     target_list.push_back(target);
   }
   json results = {{"needles", needles},
-                        {"tissue_E_MPa", in.tissue_E_MPa},
-                        {"tissue_E_source", in.tissue_E_source},
-                        {"groove_fill_definition",
-                         "mean over the groove's length inside the tissue of the share of the groove's depth (floor to the rod's top) "
-                         "that tissue fills, measured in the needle's own frame at the end of insertion (report.md, docs/paper.md)"},
-                        {"targets", target_list},
-                        {"tissue", tissue},
-                        {"reference", fs::proximate(in.reference_path).string()}};
+                  {"tissue_E_MPa", in.tissue_E_MPa},
+                  {"tissue_E_source", in.tissue_E_source},
+                  {"groove_fill_definition",
+                   "mean over the groove's length inside the tissue of the share of the groove's depth (floor to the rod's top) "
+                   "that tissue fills, measured in the needle's own frame at the end of insertion (report.md, docs/paper.md)"},
+                  {"targets", target_list},
+                  {"tissue", tissue},
+                  {"reference", fs::proximate(in.reference_path).string()}};
   for (const ModelResults& m : replicas) results["replicas"].push_back({{"label", m.label}, {"results", m.path}});
 
   // The pictures.

@@ -12,7 +12,8 @@
 #   CALIBRATION=calib/calibration.json scripts/scatter_study.sh ...   (default data/paper/calibration_sb.json)
 #
 # Two runs at once (one thread each), each a one-needle report OUT/entry<shift>_<needle>. A finished run
-# (OUT/entry<shift>_<needle>/runs/<needle>/summary.json) is kept, so an interrupted study resumes. About 80 min a run with four at once on two cores, 40 min alone on two threads.
+# (OUT/entry<shift>_<needle>/runs/<needle>/summary.json) is kept, so an interrupted study resumes. About 76 min a run with
+# four at once on the two cores; 40 min alone on two threads.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out="${1:-out/scatter}"
@@ -30,6 +31,9 @@ for s in "${shifts[@]}"; do
   study_number scatter_study "'$s'" "$s" ">0" "a shift in mm" 0.1
 done
 read -r -a needles <<< "${NEEDLES:-SB LMB AMB}"
+for needle in "${needles[@]}"; do
+  [[ " SB LMB AMB HMB " == *" $needle "* ]] || { echo "scatter_study: NEEDLES: '$needle' is not one of SB, LMB, AMB, HMB" >&2; exit 2; }
+done
 
 # scatter_run NEEDLE SHIFT: one needle's 30 mm run with the entry face SHIFT mm ahead, unless it is there already.
 scatter_run() {
