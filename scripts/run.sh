@@ -25,7 +25,7 @@ done
 ./build/bench/bench_needle | tee out/bench_needle.txt
 ./build/bench/bench_insertion | tee out/bench_insertion.txt
 # The paper reproduced: SB, LMB, AMB and HMB on the paper's scene with the tissue E calibrated on SB
-# (data/paper/calibration_sb.json, made by `needle calibrate`; docs/paper.md), about 40 minutes a needle
+# (data/paper/calibration_sb.json, made by `needle calibrate`; docs/paper.md), about 20–40 minutes a needle
 # on 2 cores. A run the solver stops is reported as such in the report, not an error of the main job.
 # The report sets five other models beside it, from their stored reports in docs/paper_results/: the
 # contact's former default (skin 0.04 mm, factor 10), skin 0.02 mm at factor 10, the groove 5 mm behind

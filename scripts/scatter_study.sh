@@ -13,7 +13,7 @@
 #
 # Two runs at once (one thread each), each a one-needle report OUT/entry<shift>_<needle>. A finished run
 # (OUT/entry<shift>_<needle>/runs/<needle>/summary.json) is kept, so an interrupted study resumes. About 76 min a run with
-# four at once on the two cores; 40 min alone on two threads.
+# four at once on the two cores; 21 min alone on two idle threads.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out="${1:-out/scatter}"
