@@ -12,16 +12,6 @@
 namespace needle {
 using json = nlohmann::json;
 
-namespace {
-
-const NeedleOutcome* find_run(const std::vector<NeedleOutcome>& runs, const std::string& name) {
-  for (const NeedleOutcome& r : runs)
-    if (r.name == name) return &r;
-  return nullptr;
-}
-
-}  // namespace
-
 ComparedModel parse_compared_model(const std::string& text, const char* flag) {
   const auto eq = text.find('=');
   NEEDLE_REQUIRE(eq != std::string::npos && eq > 0 && eq + 1 < text.size(),
@@ -60,7 +50,7 @@ RgbImage model_bars(const std::vector<ModelResults>& models, const std::vector<s
   for (size_t k = 0; k < models.size(); ++k) {
     BarSeries s{models[k].label, {}, compared_model_colour(static_cast<int>(k))};
     for (const std::string& n : needles) {
-      const NeedleOutcome* r = find_run(models[k].needles, n);
+      const NeedleOutcome* r = find_outcome(models[k].needles, n);
       s.values.push_back(r ? r->deflection_mm : kNaN);
     }
     chart.series.push_back(s);
@@ -89,10 +79,10 @@ std::string models_section(const std::vector<ModelResults>& models, const std::v
   md += " targets met at its E |\n" + rule + "---|\n";
   auto ratio = [](double d, double sb) { return std::isfinite(d) && std::isfinite(sb) && sb != 0 ? fmt::format(" ({:+.2f})", d / sb) : std::string(); };
   for (const ModelResults& m : models) {
-    const NeedleOutcome* sb = find_run(m.needles, "SB");
+    const NeedleOutcome* sb = find_outcome(m.needles, "SB");
     md += fmt::format("| {} | {} | {} |", m.label, m.tissue, std::isfinite(m.tissue_E_MPa) ? fmt::format("{:.4g}", m.tissue_E_MPa) : "n/a");
     for (const std::string& n : needles) {
-      const NeedleOutcome* r = find_run(m.needles, n);
+      const NeedleOutcome* r = find_outcome(m.needles, n);
       md += r ? fmt::format(" {}{}{} |", fmt_mm(r->deflection_mm), n == "SB" ? "" : ratio(r->deflection_mm, sb ? sb->deflection_mm : kNaN),
                             r->status == "finished" ? "" : " stopped")
               : " |";
@@ -126,8 +116,8 @@ std::string models_section(const std::vector<ModelResults>& models, const std::v
     if (n == "SB" || !ref || !ref_sb || ref_sb->deflection_experiment_mm == 0) continue;
     double lo = kNaN, hi = kNaN;
     for (const ModelResults& m : models) {
-      const NeedleOutcome* r = find_run(m.needles, n);
-      const NeedleOutcome* sb = find_run(m.needles, "SB");
+      const NeedleOutcome* r = find_outcome(m.needles, n);
+      const NeedleOutcome* sb = find_outcome(m.needles, "SB");
       if (!r || !sb || !std::isfinite(r->deflection_mm / sb->deflection_mm)) continue;  // also SB at 0
       const double q = r->deflection_mm / sb->deflection_mm;
       lo = std::isfinite(lo) ? std::min(lo, q) : q;
@@ -146,7 +136,7 @@ std::string models_section(const std::vector<ModelResults>& models, const std::v
   for (const ModelResults& m : models) {
     md += fmt::format("| {} |", m.label);
     for (const std::string& n : needles) {
-      const NeedleOutcome* r = find_run(m.needles, n);
+      const NeedleOutcome* r = find_outcome(m.needles, n);
       md += r ? fmt::format(" {} |", fmt_mm(r->groove_fill, "{:.3f}")) : " |";
     }
     md += "\n";

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <iterator>
 #include <fmt/format.h>
-#include <map>
 #include <nlohmann/json.hpp>
 
 #include "apps/json_file.h"
@@ -56,11 +55,15 @@ const PaperReferenceNeedle* find_reference(const std::vector<PaperReferenceNeedl
 
 std::string fmt_mm(double v, const char* f) { return std::isfinite(v) ? fmt::format(fmt::runtime(f), v) : std::string("n/a"); }
 
+const NeedleOutcome* find_outcome(const std::vector<NeedleOutcome>& runs, const std::string& name) {
+  for (const NeedleOutcome& r : runs)
+    if (r.name == name) return &r;
+  return nullptr;
+}
+
 std::vector<PaperTarget> evaluate_paper_targets(const std::vector<NeedleOutcome>& runs, const std::vector<PaperReferenceNeedle>& reference) {
-  std::map<std::string, const NeedleOutcome*> by;
-  for (const NeedleOutcome& r : runs) by[r.name] = &r;
-  auto delta = [&](const char* n) { return by.count(n) ? by[n]->deflection_mm : kNaN; };
-  auto fill = [&](const char* n) { return by.count(n) ? by[n]->groove_fill : kNaN; };
+  auto delta = [&](const char* n) { const NeedleOutcome* r = find_outcome(runs, n); return r ? r->deflection_mm : kNaN; };
+  auto fill = [&](const char* n) { const NeedleOutcome* r = find_outcome(runs, n); return r ? r->groove_fill : kNaN; };
   std::vector<PaperTarget> out;
   const double sb = delta("SB"), lmb = delta("LMB"), amb = delta("AMB"), hmb = delta("HMB");
   {

@@ -41,6 +41,9 @@ struct PaperTarget {
   bool met = false, checked = false;
 };
 
+// The named needle's outcome among runs, or null.
+const NeedleOutcome* find_outcome(const std::vector<NeedleOutcome>& runs, const std::string& name);
+
 std::vector<PaperTarget> evaluate_paper_targets(const std::vector<NeedleOutcome>& runs, const std::vector<PaperReferenceNeedle>& reference);
 
 // A number in mm with its sign ("n/a" when not finite).

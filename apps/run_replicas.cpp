@@ -7,18 +7,8 @@
 
 namespace needle {
 
-namespace {
-
-const NeedleOutcome* find_outcome(const std::vector<NeedleOutcome>& runs, const std::string& name) {
-  for (const NeedleOutcome& r : runs)
-    if (r.name == name) return &r;
-  return nullptr;
-}
-
-}  // namespace
-
-ReplicaScatter replica_scatter(const std::vector<NeedleOutcome>& runs, const std::vector<ModelResults>& replicas,
-                               const std::vector<PaperReferenceNeedle>& reference) {
+ReplicaScatter replica_scatter(const std::vector<NeedleOutcome>& runs, const std::vector<PaperTarget>& here,
+                               const std::vector<ModelResults>& replicas, const std::vector<PaperReferenceNeedle>& reference) {
   ReplicaScatter out;
   for (const NeedleOutcome& r : runs) {
     NeedleScatter s;
@@ -40,7 +30,6 @@ ReplicaScatter replica_scatter(const std::vector<NeedleOutcome>& runs, const std
 
   // Each replica's runs, with this report's where it has none. A target whose numbers come out as this
   // report's did not see the replica (it lacks the target's needles), so it is not counted for it.
-  const std::vector<PaperTarget> here = evaluate_paper_targets(runs, reference);
   out.targets.resize(here.size());
   for (const ModelResults& m : replicas) {
     std::vector<NeedleOutcome> merged;

@@ -32,8 +32,9 @@ struct ReplicaScatter {
   std::vector<TargetInReplicas> targets;   // in evaluate_paper_targets' order
 };
 
-ReplicaScatter replica_scatter(const std::vector<NeedleOutcome>& runs, const std::vector<ModelResults>& replicas,
-                               const std::vector<PaperReferenceNeedle>& reference);
+// `here` is evaluate_paper_targets of `runs`.
+ReplicaScatter replica_scatter(const std::vector<NeedleOutcome>& runs, const std::vector<PaperTarget>& here,
+                               const std::vector<ModelResults>& replicas, const std::vector<PaperReferenceNeedle>& reference);
 
 // The report's section "Run-to-run scatter" (Markdown): the deflections, their spread, and each target's verdict
 // in the replicas.
