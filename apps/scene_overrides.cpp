@@ -164,29 +164,35 @@ void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
 
 std::string scene_override_arguments(const SceneOverrides& o) {
   std::string line;
-  if (!std::isnan(o.travel_mm)) line += fmt::format(" --travel-mm {}", o.travel_mm);
-  if (!std::isnan(o.spacing_mm)) line += fmt::format(" --spacing-mm {}", o.spacing_mm);
-  if (!std::isnan(o.mesh_size_mm)) line += fmt::format(" --mesh-size-mm {}", o.mesh_size_mm);
+  auto number = [&](const char* flag, double v) {  // NaN: not given
+    if (!std::isnan(v)) line += fmt::format(" {} {}", flag, v);
+  };
+  auto list = [&](const char* flag, const std::vector<double>& v) {
+    if (!v.empty()) line += fmt::format(" {} {}", flag, fmt::join(v, ","));
+  };
+  number("--travel-mm", o.travel_mm);
+  number("--spacing-mm", o.spacing_mm);
+  number("--mesh-size-mm", o.mesh_size_mm);
   if (o.path_refinement != 0) line += fmt::format(" --path-refinement {}", o.path_refinement);
   if (o.no_needle_cut) line += " --no-needle-cut";
-  if (!std::isnan(o.tissue_nu)) line += fmt::format(" --tissue-nu {}", o.tissue_nu);
-  if (!std::isnan(o.tissue_friction)) line += fmt::format(" --tissue-friction {}", o.tissue_friction);
+  number("--tissue-nu", o.tissue_nu);
+  number("--tissue-friction", o.tissue_friction);
   if (!o.tissue_law.empty()) line += fmt::format(" --tissue-law {}", o.tissue_law);
-  if (!std::isnan(o.speed_m_per_s)) line += fmt::format(" --speed-m-per-s {}", o.speed_m_per_s);
-  if (!std::isnan(o.decel_time_ms)) line += fmt::format(" --decel-time-ms {}", o.decel_time_ms);
-  if (!std::isnan(o.hold_ms)) line += fmt::format(" --hold-ms {}", o.hold_ms);
-  if (!o.tissue_size_mm.empty()) line += fmt::format(" --tissue-size-mm {}", fmt::join(o.tissue_size_mm, ","));
-  if (!std::isnan(o.slit_half_height_mm)) line += fmt::format(" --slit-half-height-mm {}", o.slit_half_height_mm);
-  if (!std::isnan(o.relaxing_shear_fraction)) line += fmt::format(" --relaxing-shear-fraction {}", o.relaxing_shear_fraction);
-  if (!std::isnan(o.relaxation_time_ms)) line += fmt::format(" --relaxation-time-ms {}", o.relaxation_time_ms);
-  if (!std::isnan(o.cutting_pressure_MPa)) line += fmt::format(" --cutting-pressure-mpa {}", o.cutting_pressure_MPa);
-  if (!std::isnan(o.crack_reach_mm)) line += fmt::format(" --crack-reach-mm {}", o.crack_reach_mm);
-  if (!o.crack_angles_deg.empty()) line += fmt::format(" --crack-angles-deg {}", fmt::join(o.crack_angles_deg, ","));
-  if (!std::isnan(o.crack_lead_mm)) line += fmt::format(" --crack-lead-mm {}", o.crack_lead_mm);
-  if (!std::isnan(o.groove_start_mm)) line += fmt::format(" --groove-start-mm {}", o.groove_start_mm);
-  if (!std::isnan(o.contact_skin_mm)) line += fmt::format(" --contact-skin-mm {}", o.contact_skin_mm);
-  if (!std::isnan(o.contact_stiffness_factor)) line += fmt::format(" --contact-stiffness-factor {}", o.contact_stiffness_factor);
-  if (!std::isnan(o.tissue_entry_x_mm)) line += fmt::format(" --tissue-entry-x-mm {}", o.tissue_entry_x_mm);
+  number("--speed-m-per-s", o.speed_m_per_s);
+  number("--decel-time-ms", o.decel_time_ms);
+  number("--hold-ms", o.hold_ms);
+  list("--tissue-size-mm", o.tissue_size_mm);
+  number("--slit-half-height-mm", o.slit_half_height_mm);
+  number("--relaxing-shear-fraction", o.relaxing_shear_fraction);
+  number("--relaxation-time-ms", o.relaxation_time_ms);
+  number("--cutting-pressure-mpa", o.cutting_pressure_MPa);
+  number("--crack-reach-mm", o.crack_reach_mm);
+  list("--crack-angles-deg", o.crack_angles_deg);
+  number("--crack-lead-mm", o.crack_lead_mm);
+  number("--groove-start-mm", o.groove_start_mm);
+  number("--contact-skin-mm", o.contact_skin_mm);
+  number("--contact-stiffness-factor", o.contact_stiffness_factor);
+  number("--tissue-entry-x-mm", o.tissue_entry_x_mm);
   return line;
 }
 
