@@ -111,14 +111,21 @@ RgbImage deflection_plot(const std::vector<NeedleRun>& runs, const std::vector<P
   return draw_line_plot(plot);
 }
 
-RgbImage deflection_bars(const std::vector<NeedleRun>& runs, const std::vector<PaperReferenceNeedle>& reference) {
+// With replicas, each of our bars carries a whisker from the lowest to the highest deflection of that needle
+// over this report and the replicas that ran it: a bar's distance from the experiment reads against it.
+RgbImage deflection_bars(const std::vector<NeedleRun>& runs, const std::vector<PaperReferenceNeedle>& reference,
+                         const ReplicaScatter& scatter) {
   BarChart chart;
   chart.title = "Deflection at the end of insertion: this toolkit, experiment, LS-DYNA";
   chart.y_label = "deflection (mm)";
+  chart.range_label = "run-to-run spread: lowest to highest over this report and the replicas that ran the needle";
   BarSeries ours{"this toolkit", {}, kOurs}, experiment{"experiment", {}, kExperiment}, lsdyna{"LS-DYNA (paper)", {}, kLsDyna};
   for (const NeedleRun& r : runs) {
     chart.categories.push_back(r.name);
     ours.values.push_back(r.deflection_mm);
+    ours.ranges.emplace_back(kNaN, kNaN);
+    for (const NeedleScatter& s : scatter.needles)
+      if (s.name == r.name && s.replicas_with_needle > 0) ours.ranges.back() = deflection_range_mm(s);
     const PaperReferenceNeedle* ref = find_reference(reference, r.name);
     experiment.values.push_back(ref ? ref->deflection_experiment_mm : kNaN);
     lsdyna.values.push_back(ref ? ref->deflection_lsdyna_mm : kNaN);
@@ -281,7 +288,7 @@ void write_paper_report(const PaperReportInput& in) {
 
   // The pictures.
   save_png(deflection_plot(runs, in.reference), (dir / "deflection_vs_insertion.png").string());
-  save_png(deflection_bars(runs, in.reference), (dir / "deflection_bars.png").string());
+  save_png(deflection_bars(runs, in.reference, scatter), (dir / "deflection_bars.png").string());
   save_png(groove_bars(runs, in.reference), (dir / "groove_fill.png").string());
   save_png(facet_force_panels(runs), (dir / "facet_forces.png").string());
   std::vector<std::string> paper_tips;

@@ -7,6 +7,14 @@
 
 namespace needle {
 
+std::pair<double, double> deflection_range_mm(const NeedleScatter& needle) {
+  if (needle.replicas_with_needle == 0 || !std::isfinite(needle.deflection_mm)) return {kNaN, kNaN};
+  double lo = needle.deflection_mm, hi = needle.deflection_mm;
+  for (double d : needle.replica_deflection_mm)
+    if (std::isfinite(d)) lo = std::min(lo, d), hi = std::max(hi, d);
+  return {lo, hi};
+}
+
 ReplicaScatter replica_scatter(const std::vector<NeedleOutcome>& runs, const std::vector<PaperTarget>& here,
                                const std::vector<ModelResults>& replicas, const std::vector<PaperReferenceNeedle>& reference) {
   ReplicaScatter out;
@@ -14,17 +22,14 @@ ReplicaScatter replica_scatter(const std::vector<NeedleOutcome>& runs, const std
     NeedleScatter s;
     s.name = r.name;
     s.deflection_mm = r.deflection_mm;
-    double lo = r.deflection_mm, hi = r.deflection_mm;
     for (const ModelResults& m : replicas) {
       const NeedleOutcome* o = find_outcome(m.needles, r.name);
       const double d = o ? o->deflection_mm : kNaN;
       s.replica_deflection_mm.push_back(d);
-      if (!std::isfinite(d)) continue;
-      ++s.replicas_with_needle;
-      lo = std::min(lo, d);
-      hi = std::max(hi, d);
+      if (std::isfinite(d)) ++s.replicas_with_needle;
     }
-    if (s.replicas_with_needle > 0 && std::isfinite(r.deflection_mm)) s.spread_mm = hi - lo;
+    const auto [lo, hi] = deflection_range_mm(s);
+    s.spread_mm = hi - lo;  // NaN without a replica
     out.needles.push_back(s);
   }
 

@@ -5,6 +5,7 @@
 // of each deflection, and a target met here but not in a replica is met by chance, not by the model.
 // A replica may hold fewer needles than the report; for the targets its missing needles are this report's.
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "apps/model_comparison.h"
@@ -20,6 +21,9 @@ struct NeedleScatter {
   int replicas_with_needle = 0;
   double spread_mm = kNaN;                  // max - min over this report and the replicas that ran it; NaN without any
 };
+
+// {lowest, highest} deflection over this report and the replicas that ran the needle; {NaN, NaN} without any.
+std::pair<double, double> deflection_range_mm(const NeedleScatter& needle);
 
 // Per target of evaluate_paper_targets: in how many replicas it was checked and met.
 struct TargetInReplicas {

@@ -93,3 +93,53 @@ TEST_CASE("The legend stays off the bars, however long its labels", "[plot]") {
   CHECK(longest >= axes_height - 4);
   CHECK(image.height > chart.height_px);  // the legend's rows were added below
 }
+
+namespace {
+
+// The longest vertical run of pixels of colour c in any column.
+int tallest_run(const RgbImage& image, const Rgb& c) {
+  int best = 0;
+  for (int x = 0; x < image.width; ++x) {
+    int run = 0;
+    for (int y = 0; y < image.height; ++y) {
+      const size_t p = 3 * (static_cast<size_t>(y) * image.width + x);
+      const bool match = image.rgb[p] == c[0] && image.rgb[p + 1] == c[1] && image.rgb[p + 2] == c[2];
+      run = match ? run + 1 : 0;
+      best = std::max(best, run);
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+TEST_CASE("A bar's range is a whisker as long as the range, inside the axes", "[plot]") {
+  // A bar at 1.0 whose range, 0.8 to 1.6, reaches past every bar: the axes must grow to hold it,
+  // and the whisker's stem is then 0.8 / 1.0 of the bar's height (give or take its 1 px caps).
+  const Rgb bar{20, 120, 20}, whisker{200, 0, 200};
+  BarChart chart;
+  chart.title = "t";
+  chart.categories = {"one"};
+  chart.range_color = whisker;
+  chart.series = {{"a", {1.0}, bar, {{0.8, 1.6}}}};
+  const RgbImage image = draw_bar_chart(chart);
+  const int stem = tallest_run(image, whisker), bar_height = tallest_run(image, bar);
+  INFO("stem " << stem << " px, bar " << bar_height << " px");
+  REQUIRE(bar_height > 100);
+  CHECK(std::abs(stem - 0.8 * bar_height) <= 4);
+  int whisker_top = image.height;  // the axes start 50 px from the top, under the title
+  for (int y = image.height - 1; y >= 0; --y)
+    for (int x = 0; x < image.width; ++x) {
+      const size_t p = 3 * (static_cast<size_t>(y) * image.width + x);
+      if (image.rgb[p] == whisker[0] && image.rgb[p + 1] == whisker[1] && image.rgb[p + 2] == whisker[2]) whisker_top = y;
+    }
+  CHECK(whisker_top >= 50 - 1);
+  // No range label: the legend holds the series alone. With one, it gains the whisker's entry.
+  BarChart labelled = chart;
+  labelled.range_label = "spread";
+  CHECK(count_pixels(draw_bar_chart(labelled), whisker) > count_pixels(image, whisker));
+  // A NaN end draws no whisker, and the axes are the bar's own.
+  BarChart none = labelled;
+  none.series[0].ranges = {{NAN, 1.6}};
+  CHECK(count_pixels(draw_bar_chart(none), whisker) == 0);
+}
