@@ -68,6 +68,19 @@ RgbImage model_bars(const std::vector<ModelResults>& models, const std::vector<s
 
 // The section that sets this report beside other models: delta (and its ratio to SB's, which does not
 // depend on E to first order), the targets each model meets, and the groove fill.
+std::pair<double, double> ratio_to_sb_span(const std::vector<ModelResults>& models, const std::string& needle) {
+  double lo = kNaN, hi = kNaN;
+  for (const ModelResults& m : models) {
+    const NeedleOutcome* r = find_outcome(m.needles, needle);
+    const NeedleOutcome* sb = find_outcome(m.needles, "SB");
+    if (!r || !sb || !std::isfinite(r->deflection_mm / sb->deflection_mm)) continue;  // also SB at 0
+    const double q = r->deflection_mm / sb->deflection_mm;
+    lo = std::isfinite(lo) ? std::min(lo, q) : q;
+    hi = std::isfinite(hi) ? std::max(hi, q) : q;
+  }
+  return {lo, hi};
+}
+
 std::string models_section(const std::vector<ModelResults>& models, const std::vector<std::string>& needles,
                            const std::vector<PaperReferenceNeedle>& reference) {
   std::string md = "## The same needles under other models\n\n";
@@ -114,15 +127,7 @@ std::string models_section(const std::vector<ModelResults>& models, const std::v
     const PaperReferenceNeedle* ref = find_reference(reference, n);
     const PaperReferenceNeedle* ref_sb = find_reference(reference, "SB");
     if (n == "SB" || !ref || !ref_sb || ref_sb->deflection_experiment_mm == 0) continue;
-    double lo = kNaN, hi = kNaN;
-    for (const ModelResults& m : models) {
-      const NeedleOutcome* r = find_outcome(m.needles, n);
-      const NeedleOutcome* sb = find_outcome(m.needles, "SB");
-      if (!r || !sb || !std::isfinite(r->deflection_mm / sb->deflection_mm)) continue;  // also SB at 0
-      const double q = r->deflection_mm / sb->deflection_mm;
-      lo = std::isfinite(lo) ? std::min(lo, q) : q;
-      hi = std::isfinite(hi) ? std::max(hi, q) : q;
-    }
+    const auto [lo, hi] = ratio_to_sb_span(models, n);
     if (!std::isfinite(lo)) continue;
     const double e = ref->deflection_experiment_mm / ref_sb->deflection_experiment_mm;
     md += fmt::format("- {}: the models' delta / delta_SB span {:+.2f} to {:+.2f}; the experiment's {:+.2f} lies {}.\n", n, lo, hi, e,

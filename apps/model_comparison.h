@@ -5,6 +5,7 @@
 // order), the targets each model meets, whether the models' spread covers the experiment, the groove
 // fill of each, and models.png.
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "apps/paper_results.h"
@@ -28,6 +29,10 @@ struct ModelResults {
 
 // InputError if the file cannot be read or holds no needles.
 ModelResults read_model_results(const ComparedModel& model);
+
+// The lowest and highest delta / delta_SB of the needle over the models that ran it and SB (the ratio does not
+// depend on E to first order); {NaN, NaN} where none did.
+std::pair<double, double> ratio_to_sb_span(const std::vector<ModelResults>& models, const std::string& needle);
 
 // delta of each model, the experiment and LS-DYNA, per needle.
 RgbImage model_bars(const std::vector<ModelResults>& models, const std::vector<std::string>& needles,

@@ -12,6 +12,7 @@
 #include "apps/csv_table.h"
 #include "apps/json_file.h"
 #include "apps/run_model_description.h"
+#include "apps/target_gaps.h"
 #include "apps/scene.h"
 #include "geometry/cad_solid.h"
 #include "geometry/grinding_recipe.h"
@@ -72,6 +73,26 @@ NeedleRun read_run(const std::string& out_dir, const std::string& name) {
   r.history = read_csv_table((fs::path(r.folder) / "history.csv").string());
   r.facets = read_csv_table((fs::path(r.folder) / "facet_forces.csv").string());
   return r;
+}
+
+// The tissue's y force on the tip facets, the groove (floor and walls) and the shaft in the run's last
+// facet_forces.csv row; NaN where the run recorded none.
+NeedleEndLoads end_loads(const NeedleRun& r) {
+  NeedleEndLoads l;
+  l.name = r.name;
+  if (r.facets.rows.empty()) return l;
+  l.tip_facets_N = l.groove_N = l.shaft_N = 0;
+  const std::vector<double>& last = r.facets.rows.back();
+  const std::string suffix = "_fy_N";
+  for (size_t k = 0; k < r.facets.columns.size(); ++k) {
+    const std::string& c = r.facets.columns[k];
+    if (c.size() <= suffix.size() || c.compare(c.size() - suffix.size(), suffix.size(), suffix) != 0 || !std::isfinite(last[k])) continue;
+    const std::string tag = c.substr(0, c.size() - suffix.size());
+    if (tag == "groove_floor" || tag == "groove_wall") l.groove_N += last[k];
+    else if (tag == "shaft") l.shaft_N += last[k];
+    else if (tag != "base") l.tip_facets_N += last[k];
+  }
+  return l;
 }
 
 void save_png(const RgbImage& image, const std::string& path) {
@@ -363,6 +384,12 @@ void write_paper_report(const PaperReportInput& in) {
                             scatter.targets[i].checked - scatter.targets[i].met, scatter.targets[i].checked);
     md += fmt::format("| {} | {} | {} |\n", t.what, t.numbers, verdict);
   }
+  {
+    TargetGapInput gaps{targets, outcomes, {}, models, replicas.empty() ? nullptr : &scatter, in.reference};
+    for (const NeedleRun& r : runs) gaps.loads.push_back(end_loads(r));
+    const std::string section = target_gaps_section(gaps);
+    if (!section.empty()) md += "\n" + section;
+  }
   if (!replicas.empty()) md += "\n" + replica_section(scatter, replicas, targets);
   if (!models.empty()) md += "\n" + models_section(models, in.needles, in.reference);
   md += models.empty() ? "\n## Groove filling\n\n" : "## Groove filling\n\n";
@@ -398,19 +425,10 @@ void write_paper_report(const PaperReportInput& in) {
         "pressed down, it pushes the shaft up along all of it.\n\n";
   md += "| needle | tip facets | groove floor and walls | shaft | bonds broken (cut by the needle) |\n|---|---|---|---|---|\n";
   for (const NeedleRun& r : runs) {
-    if (r.facets.rows.empty()) continue;
-    double tip = 0, groove = 0, shaft = 0;
-    const std::vector<double>& last = r.facets.rows.back();
-    for (size_t k = 0; k < r.facets.columns.size(); ++k) {
-      const std::string& c = r.facets.columns[k];
-      const std::string suffix = "_fy_N";
-      if (c.size() <= suffix.size() || c.compare(c.size() - suffix.size(), suffix.size(), suffix) != 0 || !std::isfinite(last[k])) continue;
-      const std::string tag = c.substr(0, c.size() - suffix.size());
-      if (tag == "groove_floor" || tag == "groove_wall") groove += last[k];
-      else if (tag == "shaft") shaft += last[k];
-      else if (tag != "base") tip += last[k];
-    }
-    md += fmt::format("| {} | {:+.3f} | {:+.3f} | {:+.3f} | {} ({}) |\n", r.name, tip, groove, shaft, r.bonds_broken, r.bonds_cut_by_needle);
+    const NeedleEndLoads l = end_loads(r);
+    if (!std::isfinite(l.shaft_N)) continue;
+    md += fmt::format("| {} | {:+.3f} | {:+.3f} | {:+.3f} | {} ({}) |\n", r.name, l.tip_facets_N, l.groove_N, l.shaft_N, r.bonds_broken,
+                      r.bonds_cut_by_needle);
   }
   const auto runs_cutting = std::count_if(runs.begin(), runs.end(), [](const NeedleRun& r) { return r.needle_cuts; });
   md += "\nThe needle bends the way the sum of the three columns points. The paper's tissue is cut at the tip point A and only "

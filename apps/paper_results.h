@@ -39,6 +39,10 @@ struct NeedleOutcome {
 struct PaperTarget {
   std::string what, numbers;
   bool met = false, checked = false;
+  // A deflection target's needle, its error against the experiment (signed, mm) and the error allowed
+  // (abs(error) <= allowed; HMB's: below LS-DYNA's); empty and NaN for the others.
+  std::string needle = {};
+  double error_mm = kNaN, allowed_mm = kNaN;
 };
 
 // The named needle's outcome among runs, or null.
