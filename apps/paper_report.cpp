@@ -274,7 +274,7 @@ void write_paper_report(const PaperReportInput& in) {
               {"max_energy_balance_error", r.max_energy_error},
               {"bonds_broken", r.bonds_broken},
               {"bonds_cut_by_needle", r.bonds_cut_by_needle},
-              {"run_folder", fs::relative(r.folder, dir).string()}};
+              {"run_folder", fs::path(r.folder).lexically_relative(dir).string()}};
     if (!r.reason.empty()) n["reason"] = r.reason;
     for (const NeedleScatter& s : scatter.needles)
       if (s.name == r.name && s.replicas_with_needle > 0) {
@@ -446,7 +446,7 @@ void write_paper_report(const PaperReportInput& in) {
   md += "## Runs\n\n| needle | folder | coupling steps | max energy-balance error | max penetration (mm) | particles inside at end | "
         "bonds broken | note |\n|---|---|---|---|---|---|---|---|\n";
   for (const NeedleRun& r : runs)
-    md += fmt::format("| {} | `{}` | {} | {:.2g} | {:.3f} | {} | {} | {} |\n", r.name, fs::relative(r.folder, dir).string(), r.steps,
+    md += fmt::format("| {} | `{}` | {} | {:.2g} | {:.3f} | {} | {} | {} |\n", r.name, fs::path(r.folder).lexically_relative(dir).string(), r.steps,
                       r.max_energy_error, r.max_penetration_mm, r.particles_inside, r.bonds_broken, r.reason.empty() ? "" : r.reason);
   md += "\nEach run folder holds history.csv, facet_forces.csv, summary.json, and needle.pvd / tissue.pvd for ParaView.\n";
 

@@ -386,3 +386,17 @@ TEST_CASE("needle paper says why a deflection target is missed: margin against s
   CHECK(md.find("Over the 2 models compared in this report (this one included; below) it spans -0.88 to -0.20: the experiment's lies "
                 "inside") != std::string::npos);
 }
+
+TEST_CASE("needle paper names its own runs/NAME folder even where it is a link to a run made elsewhere", "[apps][paper]") {
+  // scripts/scatter_study.sh links each needle's run into one report folder; the report must not name the link's
+  // target, which a copy of the report folder does not carry.
+  const fs::path dir = fresh("linked"), elsewhere = fresh("linked_target");
+  write_run(elsewhere, "SB", {-1.10, 0.90});
+  fs::create_directories(dir / "runs");
+  fs::create_directory_symlink(elsewhere / "runs" / "SB", dir / "runs" / "SB");
+  const auto result = run("paper --report-only --no-tips --quiet --tissue-E-MPa 0.05 --needles SB --out " + dir.string(), true);
+  INFO(result.out);
+  REQUIRE(result.exit_code == 0);
+  CHECK(read_json(dir / "results.json")["needles"]["SB"]["run_folder"] == "runs/SB");
+  CHECK(read_text(dir / "report.md").find("| SB | `runs/SB` |") != std::string::npos);
+}
