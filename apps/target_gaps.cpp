@@ -28,7 +28,8 @@ std::string load_sentence(const NeedleEndLoads& l, double error_mm) {
                 : "the tissue holds the shaft down in the channel the tip cut"},
       {"groove", l.groove_N,
        sign > 0 ? "the tissue in the groove pushes it up" : "the tissue above the cut rebounds into the groove and presses its floor down"},
-      {"tip facets", l.tip_facets_N, sign > 0 ? "the tissue the bottom and side bevels press down pushes the tip up" : "the top bevel lifts the tissue and is pressed down"},
+      {"tip facets", l.tip_facets_N,
+       sign > 0 ? "the tissue the tip's lower facets press down pushes the tip up" : "the tissue the tip's upper facets lift presses the tip down"},
   };
   const Part* largest = nullptr;
   for (const Part& p : parts)
