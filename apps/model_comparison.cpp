@@ -66,8 +66,6 @@ RgbImage model_bars(const std::vector<ModelResults>& models, const std::vector<s
   return draw_bar_chart(chart);
 }
 
-// The section that sets this report beside other models: delta (and its ratio to SB's, which does not
-// depend on E to first order), the targets each model meets, and the groove fill.
 std::pair<double, double> ratio_to_sb_span(const std::vector<ModelResults>& models, const std::string& needle) {
   double lo = kNaN, hi = kNaN;
   for (const ModelResults& m : models) {
@@ -81,6 +79,8 @@ std::pair<double, double> ratio_to_sb_span(const std::vector<ModelResults>& mode
   return {lo, hi};
 }
 
+// The section that sets this report beside other models: delta (and its ratio to SB's, which does not
+// depend on E to first order), the targets each model meets, and the groove fill.
 std::string models_section(const std::vector<ModelResults>& models, const std::vector<std::string>& needles,
                            const std::vector<PaperReferenceNeedle>& reference) {
   std::string md = "## The same needles under other models\n\n";

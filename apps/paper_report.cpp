@@ -12,8 +12,8 @@
 #include "apps/csv_table.h"
 #include "apps/json_file.h"
 #include "apps/run_model_description.h"
-#include "apps/target_gaps.h"
 #include "apps/scene.h"
+#include "apps/target_gaps.h"
 #include "geometry/cad_solid.h"
 #include "geometry/grinding_recipe.h"
 #include "geometry/input_error.h"
@@ -144,9 +144,8 @@ RgbImage deflection_bars(const std::vector<NeedleRun>& runs, const std::vector<P
   for (const NeedleRun& r : runs) {
     chart.categories.push_back(r.name);
     ours.values.push_back(r.deflection_mm);
-    ours.ranges.emplace_back(kNaN, kNaN);
-    for (const NeedleScatter& s : scatter.needles)
-      if (s.name == r.name && s.replicas_with_needle > 0) ours.ranges.back() = deflection_range_mm(s);
+    const NeedleScatter* s = find_needle_scatter(scatter, r.name);
+    ours.ranges.push_back(s ? deflection_range_mm(*s) : std::pair<double, double>{kNaN, kNaN});
     const PaperReferenceNeedle* ref = find_reference(reference, r.name);
     experiment.values.push_back(ref ? ref->deflection_experiment_mm : kNaN);
     lsdyna.values.push_back(ref ? ref->deflection_lsdyna_mm : kNaN);
@@ -276,11 +275,10 @@ void write_paper_report(const PaperReportInput& in) {
               {"bonds_cut_by_needle", r.bonds_cut_by_needle},
               {"run_folder", fs::path(r.folder).lexically_relative(dir).string()}};
     if (!r.reason.empty()) n["reason"] = r.reason;
-    for (const NeedleScatter& s : scatter.needles)
-      if (s.name == r.name && s.replicas_with_needle > 0) {
-        n["deflection_spread_mm"] = s.spread_mm;
-        n["replicas_with_needle"] = s.replicas_with_needle;
-      }
+    if (const NeedleScatter* s = find_needle_scatter(scatter, r.name); s && s->replicas_with_needle > 0) {
+      n["deflection_spread_mm"] = s->spread_mm;
+      n["replicas_with_needle"] = s->replicas_with_needle;
+    }
     if (const PaperReferenceNeedle* ref = find_reference(in.reference, r.name)) {
       n["deflection_experiment_mm"] = ref->deflection_experiment_mm;
       n["deflection_lsdyna_mm"] = ref->deflection_lsdyna_mm;

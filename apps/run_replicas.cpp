@@ -7,6 +7,12 @@
 
 namespace needle {
 
+const NeedleScatter* find_needle_scatter(const ReplicaScatter& scatter, const std::string& name) {
+  for (const NeedleScatter& s : scatter.needles)
+    if (s.name == name) return &s;
+  return nullptr;
+}
+
 std::pair<double, double> deflection_range_mm(const NeedleScatter& needle) {
   if (needle.replicas_with_needle == 0 || !std::isfinite(needle.deflection_mm)) return {kNaN, kNaN};
   double lo = needle.deflection_mm, hi = needle.deflection_mm;

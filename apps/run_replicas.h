@@ -36,6 +36,9 @@ struct ReplicaScatter {
   std::vector<TargetInReplicas> targets;   // in evaluate_paper_targets' order
 };
 
+// The named needle's scatter, or null.
+const NeedleScatter* find_needle_scatter(const ReplicaScatter& scatter, const std::string& name);
+
 // `here` is evaluate_paper_targets of `runs`.
 ReplicaScatter replica_scatter(const std::vector<NeedleOutcome>& runs, const std::vector<PaperTarget>& here,
                                const std::vector<ModelResults>& replicas, const std::vector<PaperReferenceNeedle>& reference);

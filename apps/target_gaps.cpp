@@ -64,10 +64,8 @@ std::string target_gaps_section(const TargetGapInput& in) {
                                    lsdyna_bound ? fmt::format("where the target is an error below LS-DYNA's own, {:.2f} mm", t.allowed_mm)
                                                 : fmt::format("{:.2f} mm allowed", t.allowed_mm));
     // Chance or model: the run-to-run scatter against the margin.
-    const NeedleScatter* scatter = nullptr;
-    if (in.scatter)
-      for (const NeedleScatter& s : in.scatter->needles)
-        if (s.name == t.needle && std::isfinite(s.spread_mm)) scatter = &s;
+    const NeedleScatter* scatter = in.scatter ? find_needle_scatter(*in.scatter, t.needle) : nullptr;
+    if (scatter && !std::isfinite(scatter->spread_mm)) scatter = nullptr;  // no replica ran this needle
     const double margin = std::abs(t.error_mm) - t.allowed_mm;  // > 0: missed by this much
     if (scatter) {
       if (t.met)
