@@ -10,22 +10,26 @@ using namespace needle;
 
 namespace {
 
+bool has_colour(const RgbImage& image, int x, int y, const Rgb& c) {
+  const size_t p = 3 * (static_cast<size_t>(y) * image.width + x);
+  return image.rgb[p] == c[0] && image.rgb[p + 1] == c[1] && image.rgb[p + 2] == c[2];
+}
+
 long count_pixels(const RgbImage& image, const Rgb& c) {
   long n = 0;
-  for (size_t p = 0; p + 2 < image.rgb.size(); p += 3)
-    if (image.rgb[p] == c[0] && image.rgb[p + 1] == c[1] && image.rgb[p + 2] == c[2]) ++n;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) n += has_colour(image, x, y, c);
   return n;
 }
 
-// The longest horizontal run of pixels of colour c in any row.
-int widest_run(const RgbImage& image, const Rgb& c) {
+// The longest run of pixels of colour c in any row (along x) or, with along_y, in any column.
+int longest_run(const RgbImage& image, const Rgb& c, bool along_y = false) {
+  const int lines = along_y ? image.width : image.height, length = along_y ? image.height : image.width;
   int best = 0;
-  for (int y = 0; y < image.height; ++y) {
+  for (int line = 0; line < lines; ++line) {
     int run = 0;
-    for (int x = 0; x < image.width; ++x) {
-      const size_t p = 3 * (static_cast<size_t>(y) * image.width + x);
-      const bool match = image.rgb[p] == c[0] && image.rgb[p + 1] == c[1] && image.rgb[p + 2] == c[2];
-      run = match ? run + 1 : 0;
+    for (int k = 0; k < length; ++k) {
+      run = (along_y ? has_colour(image, line, k, c) : has_colour(image, k, line, c)) ? run + 1 : 0;
       best = std::max(best, run);
     }
   }
@@ -68,7 +72,7 @@ TEST_CASE("Value labels fit their bars when many series share a group", "[plot]"
   const int label = small.width("+2.58");
   INFO("label " << label << " px, image " << image.width << " px wide");
   REQUIRE(label > 0);  // the font is installed (scripts/install-deps.sh)
-  CHECK(widest_run(image, probe) >= label);
+  CHECK(longest_run(image, probe) >= label);
   CHECK(image.width > chart.width_px);  // 24 bars of a 900 px chart could not hold their labels
 }
 
@@ -84,8 +88,7 @@ TEST_CASE("The legend stays off the bars, however long its labels", "[plot]") {
   int run = 0, longest = 0;
   const int middle = image.width / 2 + 35;  // the axes start 90 px from the left, end 20 px from the right
   for (int y = 0; y < image.height; ++y) {
-    const size_t p = 3 * (static_cast<size_t>(y) * image.width + middle);
-    run = (image.rgb[p] == bar[0] && image.rgb[p + 1] == bar[1] && image.rgb[p + 2] == bar[2]) ? run + 1 : 0;
+    run = has_colour(image, middle, y, bar) ? run + 1 : 0;
     longest = std::max(longest, run);
   }
   const int axes_height = chart.height_px - 50 - 60;
@@ -93,25 +96,6 @@ TEST_CASE("The legend stays off the bars, however long its labels", "[plot]") {
   CHECK(longest >= axes_height - 4);
   CHECK(image.height > chart.height_px);  // the legend's rows were added below
 }
-
-namespace {
-
-// The longest vertical run of pixels of colour c in any column.
-int tallest_run(const RgbImage& image, const Rgb& c) {
-  int best = 0;
-  for (int x = 0; x < image.width; ++x) {
-    int run = 0;
-    for (int y = 0; y < image.height; ++y) {
-      const size_t p = 3 * (static_cast<size_t>(y) * image.width + x);
-      const bool match = image.rgb[p] == c[0] && image.rgb[p + 1] == c[1] && image.rgb[p + 2] == c[2];
-      run = match ? run + 1 : 0;
-      best = std::max(best, run);
-    }
-  }
-  return best;
-}
-
-}  // namespace
 
 TEST_CASE("A bar's range is a whisker as long as the range, inside the axes", "[plot]") {
   // A bar at 1.0 whose range, 0.8 to 1.6, reaches past every bar: the axes must grow to hold it,
@@ -123,16 +107,14 @@ TEST_CASE("A bar's range is a whisker as long as the range, inside the axes", "[
   chart.range_color = whisker;
   chart.series = {{"a", {1.0}, bar, {{0.8, 1.6}}}};
   const RgbImage image = draw_bar_chart(chart);
-  const int stem = tallest_run(image, whisker), bar_height = tallest_run(image, bar);
+  const int stem = longest_run(image, whisker, true), bar_height = longest_run(image, bar, true);
   INFO("stem " << stem << " px, bar " << bar_height << " px");
   REQUIRE(bar_height > 100);
   CHECK(std::abs(stem - 0.8 * bar_height) <= 4);
   int whisker_top = image.height;  // the axes start 50 px from the top, under the title
   for (int y = image.height - 1; y >= 0; --y)
-    for (int x = 0; x < image.width; ++x) {
-      const size_t p = 3 * (static_cast<size_t>(y) * image.width + x);
-      if (image.rgb[p] == whisker[0] && image.rgb[p + 1] == whisker[1] && image.rgb[p + 2] == whisker[2]) whisker_top = y;
-    }
+    for (int x = 0; x < image.width; ++x)
+      if (has_colour(image, x, y, whisker)) whisker_top = y;
   CHECK(whisker_top >= 50 - 1);
   // No range label: the legend holds the series alone. With one, it gains the whisker's entry.
   BarChart labelled = chart;
