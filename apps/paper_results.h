@@ -43,6 +43,7 @@ struct PaperTarget {
   // (abs(error) <= allowed; HMB's: below LS-DYNA's); empty and NaN for the others.
   std::string needle = {};
   double error_mm = kNaN, allowed_mm = kNaN;
+  std::string allowance = {};  // the allowance in words, e.g. "0.10 mm allowed"
 };
 
 // The named needle's outcome among runs, or null.
