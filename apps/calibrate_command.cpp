@@ -21,7 +21,7 @@
 #include "apps/scene_overrides.h"
 #include "apps/json_file.h"
 #include "apps/scene.h"
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 #include "geometry/mesh_io.h"
 #include "plot/line_plot.h"
 

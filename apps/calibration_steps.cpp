@@ -4,7 +4,7 @@
 #include <cmath>
 #include <fmt/format.h>
 
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 
 namespace needle {
 

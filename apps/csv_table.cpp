@@ -7,7 +7,7 @@
 #include <limits>
 #include <sstream>
 
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 
 namespace needle {
 namespace {

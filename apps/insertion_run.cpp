@@ -5,15 +5,22 @@
 #include <fmt/format.h>
 #include <fstream>
 
+#include "apps/json_file.h"
 #include "apps/run_folder.h"
 #include "apps/scene_needle.h"
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 #include "mesher/particle_lattice.h"
 #include "mesher/vtk_files.h"
-#include "solver/groove_fill.h"
-#include "solver/lspg_insertion.h"
-#include "solver/parallel.h"
-#include "solver/solver_error.h"
+#include "solver/insertion/groove_fill.h"
+#include "solver/insertion/coupled_insertion.h"
+#include "solver/needle/needle_models.h"
+#include "solver/separation/separation_models.h"
+#include "core/parallel.h"
+#include "core/solver_error.h"
+
+#ifndef NEEDLE_DATA_DIR
+#define NEEDLE_DATA_DIR "data"
+#endif
 
 namespace needle {
 namespace {
@@ -51,7 +58,7 @@ Eigen::VectorXd broken_bonds(const SpgTissue& tissue) {
 }
 
 // The groove fill of the run's current state (groove_fill.h); empty without a groove.
-GrooveFill run_groove_fill(LspgInsertion& run, const SceneNeedle& needle, const Scene& scene) {
+GrooveFill run_groove_fill(CoupledInsertion& run, const SceneNeedle& needle, const Scene& scene) {
   if (!needle.groove) return {};
   const TissueParticles& p = run.tissue().particles();
   NeedleTissueContact& contact = run.contact_model();
@@ -73,13 +80,17 @@ GrooveFill run_groove_fill(LspgInsertion& run, const SceneNeedle& needle, const 
 
 class InsertionOutput {
  public:
-  InsertionOutput(const RunFolder& folder, const ContactSurface& surface) : folder_(folder), surface_(surface) {
+  InsertionOutput(const RunFolder& folder, const ContactSurface& surface, const std::vector<std::unique_ptr<SeparationModel>>& separations)
+      : folder_(folder), surface_(surface) {
     history_.open(folder.path("history.csv"));
     history_ << "time_ms,insertion_mm,tip_dx_mm,tip_dy_mm,tip_dz_mm,deflection_mm,drive_force_x_N,drive_force_y_N,drive_force_z_N,"
                 "contact_force_x_N,contact_force_y_N,contact_force_z_N,particles_in_contact,particles_inside,max_depth_mm,"
                 "bonds_broken,tissue_kinetic_mJ,tissue_internal_mJ,needle_kinetic_mJ,needle_strain_mJ,drive_work_mJ,"
                 "cannula_work_mJ,contact_work_mJ,penalty_energy_mJ,friction_dissipation_mJ,relinearisation_energy_mJ,energy_balance_error,"
-                "coupling_step_ms,needle_steps,groove_fill,groove_floor_contact_fraction,bonds_cut_by_needle\n";
+                "coupling_step_ms,needle_steps,groove_fill,groove_floor_contact_fraction";
+    for (const auto& separation : separations)
+      for (const std::string& column : separation->history_columns()) history_ << "," << column;
+    history_ << "\n";
     facets_.open(folder.path("facet_forces.csv"));
     facets_ << "time_ms,insertion_mm";
     for (const std::string& tag : surface.tag_names())
@@ -88,20 +99,23 @@ class InsertionOutput {
     facets_ << "\n";
   }
 
-  void record(const LspgInsertion& run, int tip, const GrooveFill& groove) {
-    const NeedleDynamics& n = run.needle();
-    const Eigen::RowVector3d u = n.positions_mm().row(tip) - n.needle().mesh().X.row(tip);
+  void record(const CoupledInsertion& run, int tip, const GrooveFill& groove) {
+    const NeedleModel& n = run.needle();
+    const Eigen::RowVector3d u = n.positions_mm().row(tip) - n.mesh().X.row(tip);
     const Eigen::Vector3d drive = n.drive_displacement_mm(), reaction = n.drive_reaction_N();
     const ContactReport& c = run.contact();
     const InsertionEnergy& e = run.energy();
     history_ << fmt::format(
         "{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{},{},{:.6g},{},{:.9g},{:.9g},{:.9g},{:.9g},"
-        "{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.6g},{:.6g},{},{:.4f},{:.4f},{}\n",
+        "{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.6g},{:.6g},{},{:.4f},{:.4f}",
         run.time_ms(), drive.norm(), u.x(), u.y(), u.z(), u.y() - drive.y(), reaction.x(), reaction.y(), reaction.z(),
         c.force_on_needle_N.x(), c.force_on_needle_N.y(), c.force_on_needle_N.z(), c.particles_in_contact, c.particles_inside,
         c.max_depth_mm, run.bonds_broken(), e.tissue_kinetic_mJ, e.tissue_internal_mJ, e.needle_kinetic_mJ, e.needle_strain_mJ,
         e.drive_work_mJ, e.cannula_work_mJ, e.contact_work_mJ, e.penalty_energy_mJ, e.friction_dissipation_mJ, e.relinearisation_energy_mJ, e.balance_error(),
-        run.last_step_ms(), run.needle_steps(), groove.groove_fill, groove.floor_contact_fraction, run.bonds_cut_by_needle());
+        run.last_step_ms(), run.needle_steps(), groove.groove_fill, groove.floor_contact_fraction);
+    for (const auto& separation : run.separations())
+      for (const std::string& value : separation->history_values()) history_ << "," << value;
+    history_ << "\n";
     facets_ << fmt::format("{:.9g},{:.9g}", run.time_ms(), drive.norm());
     for (size_t k = 0; k < surface_.tag_names().size(); ++k) {
       if (surface_.tag_names()[k] == "symmetry") continue;
@@ -114,7 +128,7 @@ class InsertionOutput {
     facets_.flush();
   }
 
-  void frame(const LspgInsertion& run) {
+  void frame(const CoupledInsertion& run) {
     const int index = static_cast<int>(needle_frames_.size());
     const std::string needle_name = fmt::format("frames/needle_{:04}.vtu", index);
     write_needle_vtu(folder_.path(needle_name).string(), run.needle());
@@ -159,6 +173,15 @@ class InsertionOutput {
 
 }  // namespace
 
+std::string default_calibration_file() { return std::string(NEEDLE_DATA_DIR) + "/paper/calibration_sb.json"; }
+
+double calibrated_E(const std::string& path) {
+  const json j = read_json_file(path, "calibration");
+  NEEDLE_REQUIRE(j.contains("tissue_E_MPa") && j["tissue_E_MPa"].is_number() && j["tissue_E_MPa"].get<double>() > 0,
+                 fmt::format("{}: tissue_E_MPa must be a positive number", path));
+  return j["tissue_E_MPa"].get<double>();
+}
+
 Scene default_run_scene() {
   Scene s = parse_scene("{}", "(needle run defaults)");
   s.tissue.enabled = true;
@@ -174,7 +197,8 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
   // Everything that can be wrong with the input is found before the run folder exists.
   const auto start = Clock::now();
   const SceneNeedle built = build_scene_needle(scene.needle);
-  const FeNeedle needle(built.mesh, scene.needle.material, scene.needle.rigid ? 0.0 : scene.solver.mass_scaling_dt_ms);
+  const bool rigid = scene.needle.model == "rigid";  // no mass scaling: a rigid needle takes any step
+  const FeNeedle needle(built.mesh, scene.needle.material, rigid ? 0.0 : scene.solver.mass_scaling_dt_ms);
   ContactSurfaceOptions surface_options;
   surface_options.voxel_mm = scene.tissue.contact.voxel_mm;
   const ContactSurface surface(needle.mesh(), surface_options);
@@ -185,8 +209,9 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
   const bool ground_tip = !built.tip_facets.empty();  // a plain rod's end is cut square; a mesh file names no facets
   NEEDLE_REQUIRE(contact.cutting_pressure_MPa == 0 || ground_tip,
                  "a cutting pressure needs a needle with tip facets: a ground tip from a preset, d_a or a recipe (not a plain rod or a mesh file)");
-  NEEDLE_REQUIRE(!contact.crack.enabled() || ground_tip,
+  NEEDLE_REQUIRE(!scene.tissue.separation.crack.enabled() || ground_tip,
                  "a crack from the tip point needs a needle with a ground tip point: a preset, d_a or a recipe (not a plain rod or a mesh file)");
+  std::vector<std::unique_ptr<SeparationModel>> separations = make_separation_models(scene.tissue.separation, surface);
   const double setup_s = std::chrono::duration<double>(Clock::now() - start).count();
 
   RunFolder folder(o.out_dir, o.overwrite);
@@ -198,7 +223,7 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
   }
   log.line(fmt::format("scene {}", scene.source));
   log.line(fmt::format("needle {}: {} T{} elements, {} nodes, meshed in {:.2f} s{}", built.name, built.mesh.num_tets(),
-                       built.mesh.order == 2 ? 10 : 4, built.mesh.num_nodes(), built.mesh_seconds, scene.needle.rigid ? " (rigid)" : ""));
+                       built.mesh.order == 2 ? 10 : 4, built.mesh.num_nodes(), built.mesh_seconds, rigid ? " (rigid)" : ""));
   log.line(fmt::format("needle stable step {:.4g} ms (unscaled {:.4g} ms); added mass {:.3g} % in {} elements", needle.stable_time_step_ms(),
                        needle.unscaled_time_step_ms(), 100 * needle.added_mass_g() / needle.physical_mass_g(), needle.mass_scaled_elements()));
   log.line(fmt::format("contact surface: {} triangles, level set {} voxels of {} mm ({:.1f} MiB) built in {:.2f} s", surface.num_triangles(),
@@ -207,16 +232,18 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
   log.line(fmt::format("tissue: {} particles at {:.3g} mm ({:.3g} mm near the path), {} bonds; set-up {:.2f} s", particles.num_particles(),
                        scene.tissue.spacing_mm, particles.spacing_mm.minCoeff(), tissue.bonds().bonds.size(), setup_s));
 
-  NeedleDynamics needle_run(needle, driven_base_supports(needle.mesh(), scene.motion, scene.direction), scene.cannula.enabled ? std::optional<CannulaOptions>(scene.cannula) : std::nullopt,
-                            scene_dynamics_options(scene));
-  LspgInsertion run(needle_run, tissue, surface, contact, scene.solver.coupling);
+  const std::unique_ptr<NeedleModel> needle_model = make_needle_model(
+      scene.needle.model, {needle, driven_base_supports(needle.mesh(), scene.motion, scene.direction),
+                           scene.cannula.enabled ? std::optional<CannulaOptions>(scene.cannula) : std::nullopt, scene_dynamics_options(scene)});
+  const NeedleModel& needle_run = *needle_model;
+  CoupledInsertion run(*needle_model, tissue, surface, contact, std::move(separations), scene.solver.coupling);
   const int tip = nearest_node(needle.mesh(), built.tip_point);
   const double end_ms = scene.motion.end_time_ms();
   log.line(fmt::format("run to {:.6g} ms: needle step {:.4g} ms, first coupling step {:.4g} ms (tissue {:.4g}, contact {:.4g})", end_ms,
                        needle_run.time_step_ms(), run.tissue_dynamics().time_step_ms(), tissue.stable_time_step_ms(),
                        scene.solver.coupling.contact_courant * run.contact_model().stable_time_step_ms()));
 
-  InsertionOutput output(folder, surface);
+  InsertionOutput output(folder, surface, run.separations());
   output.record(run, tip, run_groove_fill(run, built, scene));
   if (scene.output.frames > 0) output.frame(run);
   ProgressBar progress(end_ms, o.quiet);
@@ -250,8 +277,7 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
   const double deflection = u.y() - needle_run.drive_displacement_mm().y();
   const InsertionEnergy& e = run.energy();
   const GrooveFill groove = run_groove_fill(run, built, scene);
-  const SymmetrySlit::Opening slit_opening = SymmetrySlit::opening(run.tissue());
-  const json summary = {
+  json summary = {
       {"status", status},
       {"reason", reason},
       {"needle", built.name},
@@ -261,9 +287,6 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
       {"time_ms", run.time_ms()},
       {"steps", run.steps()},
       {"needle_steps", run.needle_steps()},
-      {"needle_time_step_ms", needle_run.time_step_ms()},
-      {"unscaled_needle_time_step_ms", needle.unscaled_time_step_ms()},
-      {"added_mass_percent", 100 * needle.added_mass_g() / needle.physical_mass_g()},
       {"subcycling", scene.solver.coupling.subcycling},
       {"energy_balance_error", e.balance_error()},
       {"max_energy_balance_error", run.max_energy_error()},
@@ -275,11 +298,7 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
       {"max_particles_inside", run.max_particles_inside()},
       {"particles", particles.num_particles()},
       {"bonds_broken", run.bonds_broken()},
-      {"bonds_cut_by_needle", run.bonds_cut_by_needle()},
-      {"bond_cut_s", run.bond_cut_s()},
-      {"slit", {{"particles_opened", run.particles_opened_by_slit()}, {"max_opening_mm", slit_opening.max_mm},
-                {"mean_opening_mm", slit_opening.mean_mm}}},
-      {"crack", {{"reach_mm", scene.tissue.contact.crack.reach_mm}, {"bonds_cut", run.bonds_cut_by_crack()}, {"crack_s", run.crack_s()}}},
+      {"needle_model", needle_run.name()},
       {"cutting", {{"pressure_MPa", scene.tissue.contact.cutting_pressure_MPa}, {"work_mJ", run.contact_model().cutting_work_mJ()},
                    {"force_at_end_N", run.contact().cutting_force_N}}},
       {"groove",
@@ -296,6 +315,8 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
       {"mesh", {{"order", needle.mesh().order}, {"elements", needle.num_elements()}, {"nodes", needle.num_nodes()}}},
       {"threads", hardware_threads()},
   };
+  needle_run.add_summary(summary);
+  for (const auto& separation : run.separations()) separation->add_summary(summary, run.tissue());
   {
     std::ofstream out(folder.path("summary.json"));
     out << summary.dump(2) << "\n";

@@ -16,8 +16,15 @@ struct RunOptions {
 };
 
 // The run defaults of `needle run` and `needle paper`: the paper's scene with tissue, and the needle
-// fidelity that keeps a 30 mm run within minutes (docs/insertion.md measures its error).
+// fidelity that keeps a 30 mm run within minutes (docs/insertion.md measures its error). The tissue's E is
+// the card's (0.665 MPa); `needle run` replaces it by the calibrated one (default_calibration_file()).
 Scene default_run_scene();
+
+// The SB calibration shipped with the toolkit (data/paper/calibration_sb.json): the E that makes the paper's
+// SB deflect as measured, which `needle run` uses unless told otherwise.
+std::string default_calibration_file();
+// E from a calibration file written by `needle calibrate` (its tissue_E_MPa); InputError naming the file otherwise.
+double calibrated_E(const std::string& path);
 
 // InputError (nothing written) for bad input; SolverError after writing the folder if the solver stopped
 // (unless !throw_on_stop).

@@ -5,7 +5,7 @@
 #include <fmt/format.h>
 #include <fstream>
 
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 
 namespace needle {
 

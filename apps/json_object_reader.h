@@ -6,7 +6,7 @@
 #include <set>
 #include <string>
 
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 
 namespace needle {
 

@@ -5,7 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "solver/tissue_material.h"
+#include "solver/tissue/tissue_material.h"
 
 namespace needle {
 

@@ -11,11 +11,11 @@
 #include <optional>
 
 #include "apps/material_json.h"
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 #include "geometry/mesh_io.h"
 #include "plot/line_plot.h"
-#include "solver/parallel.h"
-#include "solver/uniaxial_test.h"
+#include "core/parallel.h"
+#include "solver/tissue/uniaxial_test.h"
 
 namespace needle {
 namespace {

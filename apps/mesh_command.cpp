@@ -9,7 +9,7 @@
 #include "apps/tip_source.h"
 #include "geometry/cad_solid.h"
 #include "geometry/exact_measures.h"
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 #include "geometry/mesh_io.h"
 #include "geometry/surface_measures.h"
 #include "mesher/mesh_quality.h"

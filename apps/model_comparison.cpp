@@ -6,7 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/json_file.h"
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 #include "plot/bar_chart.h"
 
 namespace needle {

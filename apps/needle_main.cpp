@@ -11,8 +11,8 @@
 #include "apps/simulate_command.h"
 #include "apps/stiffness_command.h"
 #include "apps/tip_command.h"
-#include "geometry/input_error.h"
-#include "solver/solver_error.h"
+#include "core/input_error.h"
+#include "core/solver_error.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"needle: design biopsy needle tips - grinding CAD, meshing and insertion simulation"};

@@ -16,7 +16,7 @@
 #include "apps/json_file.h"
 #include "apps/paper_report.h"
 #include "apps/scene.h"
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 
 #ifndef NEEDLE_DATA_DIR
 #define NEEDLE_DATA_DIR "data"
@@ -51,14 +51,6 @@ std::vector<std::string> split_names(const std::string& list) {
   for (const std::string& n : out)
     NEEDLE_REQUIRE(n == "SB" || n == "LMB" || n == "AMB" || n == "HMB", fmt::format("--needles: '{}' is not one of SB, LMB, AMB, HMB", n));
   return out;
-}
-
-// E from a calibration file written by `needle calibrate` (its tissue_E_MPa).
-double calibrated_E(const std::string& path) {
-  const json j = read_json_file(path, "calibration");
-  NEEDLE_REQUIRE(j.contains("tissue_E_MPa") && j["tissue_E_MPa"].is_number() && j["tissue_E_MPa"].get<double>() > 0,
-                 fmt::format("{}: tissue_E_MPa must be a positive number", path));
-  return j["tissue_E_MPa"].get<double>();
 }
 
 void paper(const PaperOptions& o) {

@@ -16,7 +16,7 @@
 #include "apps/target_gaps.h"
 #include "geometry/cad_solid.h"
 #include "geometry/grinding_recipe.h"
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 #include "geometry/mesh_io.h"
 #include "geometry/render_png.h"
 #include "geometry/tip_report.h"

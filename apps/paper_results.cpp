@@ -7,7 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/json_file.h"
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 #include "plot/line_plot.h"
 
 namespace needle {

@@ -8,7 +8,7 @@
 #include "apps/mesh_command.h"
 #include "apps/tip_source.h"
 #include "geometry/cad_solid.h"
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 #include "mesher/needle_level_set.h"
 #include "mesher/particle_lattice.h"
 #include "mesher/vtk_files.h"

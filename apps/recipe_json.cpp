@@ -5,7 +5,7 @@
 #include <set>
 
 #include "apps/json_object_reader.h"
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 
 namespace needle {
 namespace {

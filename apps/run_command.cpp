@@ -9,13 +9,13 @@
 #include "apps/insertion_run.h"
 #include "apps/scene_overrides.h"
 #include "apps/scene.h"
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 
 namespace needle {
 namespace {
 
 struct RunCommandOptions {
-  std::string preset, recipe, scene_file;
+  std::string preset, recipe, scene_file, calibration_file;
   double d_a_mm = std::nan("");
   SceneOverrides overrides;
   double mass_scaling_dt_ms = std::nan("");
@@ -43,14 +43,24 @@ void run(const RunCommandOptions& o) {
   NEEDLE_REQUIRE(std::isnan(o.mass_scaling_dt_ms) || (std::isfinite(o.mass_scaling_dt_ms) && o.mass_scaling_dt_ms >= 0),
                  "--mass-scaling-dt-ms must be zero (off) or positive");
   if (!std::isnan(o.mass_scaling_dt_ms)) scene.solver.mass_scaling_dt_ms = o.mass_scaling_dt_ms;
+  // The tissue's E: given, from a calibration, from the scene file, or (the run defaults) the SB calibration shipped
+  // with the toolkit, so that the first run a user makes is the calibrated paper scene.
+  NEEDLE_REQUIRE(std::isnan(o.tissue_E_MPa) || o.calibration_file.empty(), "give --tissue-E-MPa or --calibration, not both");
+  std::string E_source = fmt::format("from the scene {}", o.scene_file);
   if (!std::isnan(o.tissue_E_MPa)) {
     NEEDLE_REQUIRE(std::isfinite(o.tissue_E_MPa) && o.tissue_E_MPa > 0, fmt::format("--tissue-E-MPa must be a positive number (got {})", o.tissue_E_MPa));
     scene.tissue.material.E_MPa = o.tissue_E_MPa;
-    scene.tissue.material.validate();
+    E_source = "given with --tissue-E-MPa";
+  } else if (!o.calibration_file.empty() || o.scene_file.empty()) {
+    const std::string file = o.calibration_file.empty() ? default_calibration_file() : o.calibration_file;
+    scene.tissue.material.E_MPa = calibrated_E(file);
+    E_source = fmt::format("calibrated on SB: {}", file);
   }
+  scene.tissue.material.validate();
   if (o.frames >= 0) scene.output.frames = o.frames;
   if (o.no_subcycling) scene.solver.coupling.subcycling = false;
-  if (o.rigid) scene.needle.rigid = true;
+  if (o.rigid) scene.needle.model = "rigid";
+  if (!o.run.quiet) fmt::print("tissue E {:g} MPa, {}\n", scene.tissue.material.E_MPa, E_source);
   run_insertion(scene, o.run);
 }
 
@@ -68,7 +78,10 @@ void add_run_command(CLI::App& app) {
   add_scene_override_options(c, o->overrides);
   c->add_option("--mesh-size-mm", o->overrides.mesh_size_mm, "Needle mesh size over the tip and groove (run default 0.4; paper 0.2)");
   c->add_option("--mass-scaling-dt-ms", o->mass_scaling_dt_ms, "Needle selective mass scaling target step (run default 5e-6; 0: off)");
-  c->add_option("--tissue-E-MPa", o->tissue_E_MPa, "Tissue Young's modulus (the calibrated parameter; default 0.665)");
+  c->add_option("--tissue-E-MPa", o->tissue_E_MPa,
+                "Tissue Young's modulus (the calibrated parameter; default: the SB calibration data/paper/calibration_sb.json, 0.078; "
+                "the paper's card: 0.665)");
+  c->add_option("--calibration", o->calibration_file, "Take the tissue's E from this calibration (`needle calibrate`'s calibration.json)");
   c->add_option("--frames", o->frames, "ParaView frames over the run (default 20; 0: none)");
   c->add_flag("--no-subcycling", o->no_subcycling, "Tissue takes the needle's step (the plain full model; slow)");
   c->add_flag("--rigid", o->rigid, "Rigid needle (no deflection)");

@@ -7,9 +7,9 @@
 #include "apps/paper_results.h"
 #include "apps/scene.h"
 #include "geometry/grinding_recipe.h"
-#include "solver/insertion_profile.h"
-#include "solver/needle_tissue_contact.h"
-#include "solver/tissue_material.h"
+#include "solver/needle/insertion_profile.h"
+#include "solver/contact/needle_tissue_contact.h"
+#include "solver/tissue/tissue_material.h"
 
 namespace needle {
 using json = nlohmann::json;

@@ -6,7 +6,8 @@
 #include "apps/json_lines.h"
 #include "apps/material_json.h"
 #include "apps/scene_object.h"
-#include "geometry/input_error.h"
+#include "core/input_error.h"
+#include "solver/needle/needle_models.h"
 
 namespace needle {
 namespace {
@@ -58,7 +59,14 @@ void read_needle(SceneObject o, NeedleScene& n, const std::string& scene_folder)
     n.material.density_g_per_mm3 = m.quantity("density", Dimension::density, n.material.density_g_per_mm3, positive());
     m.finish();
   }
-  n.rigid = o.boolean("rigid", n.rigid);
+  // needle.model names a registered needle model (solver/needle/needle_models.h); rigid: true is the older
+  // way to say model "rigid", and the effective scene still says it so that stored scenes read the same.
+  n.model = o.text("model", n.model);
+  require_needle_model(n.model, o.where("model"));
+  if (o.boolean("rigid", n.model == "rigid")) {
+    NEEDLE_REQUIRE(n.model == "fe" || n.model == "rigid", fmt::format("{}: rigid: true contradicts model '{}'", o.where("rigid"), n.model));
+    n.model = "rigid";
+  }
   o.finish();
 }
 
@@ -135,13 +143,13 @@ void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc) {
     t.contact.voxel_mm = c.quantity("voxel", Dimension::length, t.contact.voxel_mm, within(1e-3, 0.2));
     t.contact.damping_ratio = c.number("damping_ratio", t.contact.damping_ratio, within(0.0, 1.0));
     t.contact.needle_stiffness_scale = c.number("needle_stiffness_scale", t.contact.needle_stiffness_scale, within(1e-6, 0.5));
-    t.contact.cuts_bonds = c.boolean("cuts_bonds", t.contact.cuts_bonds);
-    t.contact.slit.half_height_mm = c.quantity("slit_half_height", Dimension::length, t.contact.slit.half_height_mm, non_negative());
-    t.contact.slit.lead_mm = c.quantity("slit_lead", Dimension::length, t.contact.slit.lead_mm, non_negative());
+    t.separation.needle_cut = c.boolean("cuts_bonds", t.separation.needle_cut);
+    t.separation.slit.half_height_mm = c.quantity("slit_half_height", Dimension::length, t.separation.slit.half_height_mm, non_negative());
+    t.separation.slit.lead_mm = c.quantity("slit_lead", Dimension::length, t.separation.slit.lead_mm, non_negative());
     t.contact.cutting_pressure_MPa = c.quantity("cutting_pressure", Dimension::stress, t.contact.cutting_pressure_MPa, non_negative());
-    t.contact.crack.reach_mm = c.quantity("crack_reach", Dimension::length, t.contact.crack.reach_mm, non_negative());
-    t.contact.crack.angles_deg = c.numbers("crack_angles_deg", t.contact.crack.angles_deg, within(-180.0, 180.0));
-    t.contact.crack.lead_mm = c.quantity("crack_lead", Dimension::length, t.contact.crack.lead_mm, non_negative());
+    t.separation.crack.reach_mm = c.quantity("crack_reach", Dimension::length, t.separation.crack.reach_mm, non_negative());
+    t.separation.crack.angles_deg = c.numbers("crack_angles_deg", t.separation.crack.angles_deg, within(-180.0, 180.0));
+    t.separation.crack.lead_mm = c.quantity("crack_lead", Dimension::length, t.separation.crack.lead_mm, non_negative());
     c.finish();
   }
   o.finish();
@@ -208,7 +216,8 @@ json scene_to_json(const Scene& s) {
                     {"edge_size_mm", n.mesh.edge_size_mm}, {"shaft_size_mm", n.mesh.shaft_size_mm}, {"grading_mm", n.mesh.grading_mm}};
   needle["material"] = {{"youngs_modulus_MPa", n.material.youngs_modulus_MPa}, {"poisson_ratio", n.material.poisson_ratio},
                         {"density_g_per_cm3", n.material.density_g_per_mm3 * 1e3}};
-  needle["rigid"] = n.rigid;
+  needle["rigid"] = n.model == "rigid";
+  if (n.model != "fe" && n.model != "rigid") needle["model"] = n.model;
   const TissueScene& t = s.tissue;
   json tissue = {
       {"enabled", t.enabled}, {"size_mm", vector_json(t.size_mm)}, {"entry_x_mm", t.entry_x_mm}, {"spacing_mm", t.spacing_mm},
@@ -227,17 +236,17 @@ json scene_to_json(const Scene& s) {
                {"cfl", t.spg.cfl}}},
       {"contact", {{"stiffness_factor", t.contact.stiffness_factor}, {"skin_mm", t.contact.skin_mm}, {"voxel_mm", t.contact.voxel_mm},
                    {"damping_ratio", t.contact.damping_ratio}, {"needle_stiffness_scale", t.contact.needle_stiffness_scale},
-                   {"cuts_bonds", t.contact.cuts_bonds}}}};
+                   {"cuts_bonds", t.separation.needle_cut}}}};
   // Written only when used: stored scenes (no slit) stay as they were.
-  if (t.contact.slit.enabled()) {
-    tissue["contact"]["slit_half_height_mm"] = t.contact.slit.half_height_mm;
-    tissue["contact"]["slit_lead_mm"] = t.contact.slit.lead_mm;
+  if (t.separation.slit.enabled()) {
+    tissue["contact"]["slit_half_height_mm"] = t.separation.slit.half_height_mm;
+    tissue["contact"]["slit_lead_mm"] = t.separation.slit.lead_mm;
   }
   if (t.contact.cutting_pressure_MPa > 0) tissue["contact"]["cutting_pressure_MPa"] = t.contact.cutting_pressure_MPa;
-  if (t.contact.crack.enabled()) {
-    tissue["contact"]["crack_reach_mm"] = t.contact.crack.reach_mm;
-    tissue["contact"]["crack_angles_deg"] = t.contact.crack.angles_deg;
-    tissue["contact"]["crack_lead_mm"] = t.contact.crack.lead_mm;
+  if (t.separation.crack.enabled()) {
+    tissue["contact"]["crack_reach_mm"] = t.separation.crack.reach_mm;
+    tissue["contact"]["crack_angles_deg"] = t.separation.crack.angles_deg;
+    tissue["contact"]["crack_lead_mm"] = t.separation.crack.lead_mm;
   }
   const CannulaOptions& c = s.cannula;
   json motion = {{"accel_time_ms", s.motion.accel_time_ms}, {"speed_m_per_s", s.motion.speed_mm_per_ms}, {"travel_mm", s.motion.travel_mm},

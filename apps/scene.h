@@ -9,12 +9,13 @@
 #include <string>
 
 #include "mesher/needle_mesher.h"
-#include "solver/insertion_profile.h"
-#include "solver/lspg_insertion.h"
-#include "solver/spg_options.h"
-#include "solver/needle_material.h"
-#include "solver/rigid_cannula.h"
-#include "solver/tissue_material.h"
+#include "solver/needle/insertion_profile.h"
+#include "solver/insertion/coupled_insertion.h"
+#include "solver/separation/separation_models.h"
+#include "solver/tissue/spg_options.h"
+#include "solver/needle/needle_material.h"
+#include "solver/needle/rigid_cannula.h"
+#include "solver/tissue/tissue_material.h"
 
 namespace needle {
 
@@ -29,7 +30,7 @@ struct NeedleScene {
   bool half_model = true;   // z >= 0 half with a symmetry plane (paper)
   NeedleMeshOptions mesh;   // T10, 0.2 mm (paper)
   NeedleMaterial material;  // AISI 304
-  bool rigid = false;       // a rigid needle (no deflection; tissue studies only)
+  std::string model = "fe";  // the needle model (solver/needle/needle_models.h): "fe", or "rigid" (no deflection; tissue studies)
 };
 
 struct TissueScene {
@@ -46,6 +47,7 @@ struct TissueScene {
   TissueMaterial material;
   SpgOptions spg;                           // kernel, stabilization, bond failure, cfl (docs/solver.md)
   ContactOptions contact;                   // friction copied from `friction`
+  SeparationOptions separation;             // the needle's cut, slit and crack (keys in the contact section)
 };
 
 struct SolverScene {

@@ -4,7 +4,7 @@
 
 #include "apps/needle_build.h"
 #include "apps/recipe_json.h"
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 #include "geometry/grinding_recipe.h"
 #include "mesher/msh_file.h"
 #include "mesher/vtk_files.h"
@@ -52,14 +52,13 @@ NeedleDynamicsOptions scene_dynamics_options(const Scene& scene) {
   o.courant = scene.solver.courant;
   o.max_energy_error = scene.solver.max_energy_error;
   o.max_penetration_mm = scene.solver.max_penetration_mm;
-  o.rigid = scene.needle.rigid;
   return o;
 }
 
-void write_needle_vtu(const std::string& path, const NeedleDynamics& run) {
-  TetMesh deformed = run.needle().mesh();
+void write_needle_vtu(const std::string& path, const NeedleModel& run) {
+  TetMesh deformed = run.mesh();
   deformed.X = run.positions_mm();
-  const ElementStresses stresses = run.needle().element_stresses(run.positions_mm());
+  const ElementStresses stresses = run.element_stresses();
   write_vtu(path, deformed, {{"von_mises_MPa", stresses.von_mises_MPa}, {"cauchy_stress_MPa", stresses.cauchy_MPa}},
             {{"displacement_mm", run.displacements_mm()}, {"velocity_m_per_s", run.velocities_mm_per_ms()}});
 }

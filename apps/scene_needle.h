@@ -10,7 +10,7 @@
 #include "apps/scene.h"
 #include "geometry/tip_geometry.h"
 #include "mesher/tet_mesh.h"
-#include "solver/needle_dynamics.h"
+#include "solver/needle/needle_dynamics.h"
 
 namespace needle {
 
@@ -26,10 +26,10 @@ struct SceneNeedle {
 
 SceneNeedle build_scene_needle(const NeedleScene& needle);
 
-// The needle's step, stop criteria and rigidity from the scene's needle and solver sections.
+// The FE needle's step and stop criteria from the scene's solver section.
 NeedleDynamicsOptions scene_dynamics_options(const Scene& scene);
 
 // The deformed needle as a .vtu: displacement and velocity (points), von Mises and Cauchy stress (tets).
-void write_needle_vtu(const std::string& path, const NeedleDynamics& run);
+void write_needle_vtu(const std::string& path, const NeedleModel& run);
 
 }  // namespace needle

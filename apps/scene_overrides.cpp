@@ -4,8 +4,8 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "geometry/input_error.h"
-#include "solver/needle_tissue_contact.h"
+#include "core/input_error.h"
+#include "solver/contact/needle_tissue_contact.h"
 
 namespace needle {
 
@@ -34,7 +34,7 @@ void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
     scene.tissue.path_refinement = o.path_refinement;
   }
   if (given(o.mesh_size_mm, "--mesh-size-mm")) scene.needle.mesh.size_mm = o.mesh_size_mm;
-  if (o.no_needle_cut) scene.tissue.contact.cuts_bonds = false;
+  if (o.no_needle_cut) scene.tissue.separation.needle_cut = false;
   if (!std::isnan(o.tissue_nu)) {
     scene.tissue.material.nu = o.tissue_nu;
     scene.tissue.material.validate();
@@ -54,7 +54,7 @@ void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
   if (given_or_zero(o.slit_half_height_mm, "--slit-half-height-mm")) {
     NEEDLE_REQUIRE(o.slit_half_height_mm == 0 || scene.needle.half_model,
                    "--slit-half-height-mm needs a half model: the slit opens the symmetry plane");
-    scene.tissue.contact.slit.half_height_mm = o.slit_half_height_mm;
+    scene.tissue.separation.slit.half_height_mm = o.slit_half_height_mm;
   }
   if (!std::isnan(o.relaxing_shear_fraction) || !std::isnan(o.relaxation_time_ms)) {
     NEEDLE_REQUIRE(std::isnan(o.relaxation_time_ms) || !std::isnan(o.relaxing_shear_fraction) || scene.tissue.material.viscoelastic(),
@@ -64,15 +64,15 @@ void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
     scene.tissue.material.validate();
   }
   if (given_or_zero(o.cutting_pressure_MPa, "--cutting-pressure-mpa")) scene.tissue.contact.cutting_pressure_MPa = o.cutting_pressure_MPa;
-  if (given_or_zero(o.crack_reach_mm, "--crack-reach-mm")) scene.tissue.contact.crack.reach_mm = o.crack_reach_mm;
+  if (given_or_zero(o.crack_reach_mm, "--crack-reach-mm")) scene.tissue.separation.crack.reach_mm = o.crack_reach_mm;
   if (!o.crack_angles_deg.empty()) {
     NEEDLE_REQUIRE(std::all_of(o.crack_angles_deg.begin(), o.crack_angles_deg.end(), [](double a) { return std::isfinite(a) && a >= -180 && a <= 180; }),
                    fmt::format("--crack-angles-deg must be angles from -180 to 180 degrees (got {})", fmt::join(o.crack_angles_deg, ",")));
-    scene.tissue.contact.crack.angles_deg = o.crack_angles_deg;
+    scene.tissue.separation.crack.angles_deg = o.crack_angles_deg;
   }
-  if (given_or_zero(o.crack_lead_mm, "--crack-lead-mm")) scene.tissue.contact.crack.lead_mm = o.crack_lead_mm;
+  if (given_or_zero(o.crack_lead_mm, "--crack-lead-mm")) scene.tissue.separation.crack.lead_mm = o.crack_lead_mm;
   // The crack's shape without a crack would be dropped from scene.json without a word.
-  NEEDLE_REQUIRE((o.crack_angles_deg.empty() && std::isnan(o.crack_lead_mm)) || scene.tissue.contact.crack.enabled(),
+  NEEDLE_REQUIRE((o.crack_angles_deg.empty() && std::isnan(o.crack_lead_mm)) || scene.tissue.separation.crack.enabled(),
                  "--crack-angles-deg and --crack-lead-mm shape the tip's crack: they need --crack-reach-mm above 0 (or a scene with "
                  "tissue.contact.crack_reach_mm)");
   if (given(o.groove_start_mm, "--groove-start-mm")) {

@@ -12,11 +12,11 @@
 #include "apps/run_folder.h"
 #include "apps/scene.h"
 #include "apps/scene_needle.h"
-#include "geometry/input_error.h"
-#include "solver/needle_dynamics.h"
-#include "solver/needle_stiffness.h"
-#include "solver/parallel.h"
-#include "solver/solver_error.h"
+#include "core/input_error.h"
+#include "solver/needle/needle_dynamics.h"
+#include "solver/needle/needle_stiffness.h"
+#include "core/parallel.h"
+#include "core/solver_error.h"
 
 namespace needle {
 namespace {

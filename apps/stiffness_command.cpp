@@ -12,11 +12,11 @@
 #include "apps/needle_build.h"
 #include "apps/tip_source.h"
 #include "geometry/exact_measures.h"
-#include "geometry/input_error.h"
-#include "solver/beam_reference.h"
-#include "solver/fe_needle.h"
-#include "solver/needle_stiffness.h"
-#include "solver/parallel.h"
+#include "core/input_error.h"
+#include "solver/needle/beam_reference.h"
+#include "solver/needle/fe_needle.h"
+#include "solver/needle/needle_stiffness.h"
+#include "core/parallel.h"
 
 namespace needle {
 namespace {

@@ -8,7 +8,7 @@
 #include "apps/recipe_json.h"
 #include "apps/tip_source.h"
 #include "geometry/cad_solid.h"
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 #include "geometry/mesh_io.h"
 #include "geometry/render_png.h"
 #include "geometry/section_properties.h"

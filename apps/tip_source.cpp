@@ -1,7 +1,7 @@
 #include "apps/tip_source.h"
 
 #include "apps/recipe_json.h"
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 
 namespace needle {
 

@@ -11,7 +11,9 @@
 #include "geometry/grinding_recipe.h"
 #include "mesher/needle_mesher.h"
 #include "mesher/particle_lattice.h"
-#include "solver/lspg_insertion.h"
+#include "solver/insertion/coupled_insertion.h"
+#include "solver/needle/needle_dynamics.h"
+#include "solver/separation/separation_models.h"
 
 using namespace needle;
 using Clock = std::chrono::steady_clock;
@@ -40,7 +42,7 @@ Result insert(const TetMesh& mesh, bool subcycling, double contact_courant, doub
   CouplingOptions coupling;
   coupling.subcycling = subcycling;
   coupling.contact_courant = contact_courant;
-  LspgInsertion run(dynamics, tissue, surface, ContactOptions{}, coupling);
+  CoupledInsertion run(dynamics, tissue, surface, ContactOptions{}, make_separation_models(SeparationOptions{}, surface), coupling);
   const double end = profile.end_time_ms();
   while (run.time_ms() < end - 1e-12) run.step(end);
   const int tip = nearest_node(needle.mesh(), Eigen::Vector3d(0, -0.5, 0));

@@ -13,10 +13,10 @@
 #include "geometry/exact_measures.h"
 #include "geometry/grinding_recipe.h"
 #include "mesher/needle_mesher.h"
-#include "solver/beam_reference.h"
-#include "solver/needle_dynamics.h"
-#include "solver/needle_stiffness.h"
-#include "solver/parallel.h"
+#include "solver/needle/beam_reference.h"
+#include "solver/needle/needle_dynamics.h"
+#include "solver/needle/needle_stiffness.h"
+#include "core/parallel.h"
 
 using namespace needle;
 using Clock = std::chrono::steady_clock;

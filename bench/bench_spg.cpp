@@ -8,9 +8,9 @@
 #include <fmt/format.h>
 
 #include "mesher/particle_lattice.h"
-#include "solver/explicit_dynamics.h"
-#include "solver/parallel.h"
-#include "solver/uniaxial_test.h"
+#include "solver/tissue/tissue_dynamics.h"
+#include "core/parallel.h"
+#include "solver/tissue/uniaxial_test.h"
 
 using namespace needle;
 

@@ -10,7 +10,7 @@
 #include <fmt/format.h>
 #include <random>
 
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 #include "geometry/surface_measures.h"
 #include "geometry/tag_colors.h"
 

@@ -8,7 +8,7 @@
 #include <limits>
 #include <vector>
 
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 #include "geometry/mesh_io.h"
 #include "geometry/tag_colors.h"
 #include "plot/raster_image.h"

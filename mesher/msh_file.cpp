@@ -6,7 +6,7 @@
 #include <fmt/format.h>
 #include <map>
 
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 #include "geometry/mesh_io.h"
 #include "mesher/gmsh_model_mesh.h"
 #include "mesher/gmsh_session.h"

@@ -8,7 +8,7 @@
 #include <cmath>
 #include <fmt/format.h>
 
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 #include "geometry/surface_measures.h"
 
 namespace needle {

@@ -9,7 +9,7 @@
 #include <set>
 #include <stdexcept>
 
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 #include "mesher/gmsh_model_mesh.h"
 #include "mesher/gmsh_session.h"
 #include "mesher/mesh_quality.h"

@@ -5,7 +5,7 @@
 #include <fmt/format.h>
 #include <vector>
 
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 
 namespace needle {
 namespace {

@@ -8,7 +8,7 @@
 #include <map>
 #include <numeric>
 
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 #include "geometry/surface_measures.h"
 #include "mesher/gmsh_model_mesh.h"
 #include "mesher/gmsh_session.h"

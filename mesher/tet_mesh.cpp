@@ -5,7 +5,7 @@
 #include <set>
 #include <stdexcept>
 
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 
 namespace needle {
 

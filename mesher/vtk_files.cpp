@@ -5,7 +5,7 @@
 #include <fstream>
 #include <functional>
 
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 #include "geometry/mesh_io.h"
 
 namespace needle {

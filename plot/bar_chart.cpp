@@ -6,7 +6,7 @@
 #include <utility>
 #include <vector>
 
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 #include "plot/axis_ticks.h"
 
 namespace needle {

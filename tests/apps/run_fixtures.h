@@ -10,7 +10,7 @@
 #include "apps/csv_table.h"
 #include "apps/scene.h"
 #include "cli_run.h"
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 
 namespace needle_test {
 

@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "apps/calibration_steps.h"
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 
 using namespace needle;
 

@@ -5,7 +5,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "solver/tissue_material.h"
+#include "solver/tissue/tissue_material.h"
 #include "tests/apps/cli_run.h"
 
 namespace fs = std::filesystem;

@@ -1,7 +1,7 @@
 #include <catch2/catch.hpp>
 
 #include "apps/recipe_json.h"
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 #include "geometry/tip_geometry.h"
 
 using namespace needle;

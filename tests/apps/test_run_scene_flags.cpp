@@ -30,7 +30,7 @@ TEST_CASE("needle run --no-needle-cut: the tissue separates by bond failure alon
   CHECK(cut_scene["tissue"]["contact"]["cuts_bonds"] == true);
   CHECK(plain_scene["tissue"]["contact"]["cuts_bonds"] == false);
   CHECK(cut_summary["bonds_cut_by_needle"].get<long>() > 0);
-  CHECK(plain_summary["bonds_cut_by_needle"].get<long>() == 0);
+  CHECK_FALSE(plain_summary.contains("bonds_cut_by_needle"));  // the needle's cut is off: no model, no entry
   CHECK(plain_summary["status"] == "finished");
 }
 
@@ -136,8 +136,7 @@ TEST_CASE("needle run --slit-half-height-mm: the symmetry plane opens behind the
   const RunFiles open = run_rod_into_small_block("slit_open", "--slit-half-height-mm 0.9");
   CHECK_FALSE(closed.scene["tissue"]["contact"].contains("slit_half_height_mm"));  // stored scenes stay as they were
   CHECK(open.scene["tissue"]["contact"]["slit_half_height_mm"].get<double>() == 0.9);
-  CHECK(closed.summary["slit"]["particles_opened"].get<long>() == 0);
-  CHECK(closed.summary["slit"]["max_opening_mm"].get<double>() == 0.0);
+  CHECK_FALSE(closed.summary.contains("slit"));  // a separation model that is off reports nothing
   CHECK(open.summary["slit"]["particles_opened"].get<long>() == 4);
   CHECK(open.summary["slit"]["max_opening_mm"].get<double>() > 0);
   CHECK(open.summary["slit"]["mean_opening_mm"].get<double>() > 0);
@@ -239,13 +238,12 @@ TEST_CASE("needle run --crack-reach-mm: the scene says so, the tip's crack cuts 
   CHECK_FALSE(uncracked.scene["tissue"]["contact"].contains("crack_reach_mm"));
   CHECK(cracked.scene["tissue"]["contact"]["crack_reach_mm"].get<double>() == 1.0);
   CHECK(cracked.scene["tissue"]["contact"]["crack_angles_deg"] == nlohmann::json::array({0.0}));
-  CHECK(uncracked.summary["crack"]["bonds_cut"].get<long>() == 0);
+  CHECK_FALSE(uncracked.summary.contains("crack"));  // a separation model that is off reports nothing
   const long crack_cuts = cracked.summary["crack"]["bonds_cut"].get<long>();
   INFO("bonds cut by the crack " << crack_cuts << ", by the needle " << cracked.summary["bonds_cut_by_needle"] << " (without the crack "
                                  << uncracked.summary["bonds_cut_by_needle"] << "); balance " << cracked.summary["energy_balance_error"]);
   CHECK(crack_cuts > 0);
   CHECK(cracked.summary["crack"]["crack_s"].get<double>() > 0);
-  CHECK(uncracked.summary["crack"]["crack_s"].get<double>() == 0.0);
   CHECK(cracked.summary["bonds_broken"].get<long>() >= crack_cuts + cracked.summary["bonds_cut_by_needle"].get<long>());
   CHECK(cracked.summary["status"] == "finished");
   CHECK(cracked.summary["energy_balance_error"].get<double>() < 0.02);

@@ -15,7 +15,7 @@
 #include "apps/scene_needle.h"
 #include "cli_run.h"
 #include "run_fixtures.h"
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 
 namespace fs = std::filesystem;
 using namespace needle_test;

@@ -7,7 +7,7 @@
 
 #include "geometry/cad_solid.h"
 #include "geometry/exact_measures.h"
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 #include "geometry/surface_measures.h"
 
 using namespace needle;

@@ -5,7 +5,7 @@
 #include <fstream>
 
 #include "geometry/cad_solid.h"
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 #include "geometry/mesh_io.h"
 #include "geometry/surface_measures.h"
 

@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "geometry/cad_solid.h"
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 #include "geometry/surface_measures.h"
 
 using namespace needle;

@@ -4,7 +4,7 @@
 #include <random>
 
 #include "geometry/cad_solid.h"
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 #include "mesher/needle_level_set.h"
 #include "mesher/particle_lattice.h"
 #include "mesher/triangle_distance.h"

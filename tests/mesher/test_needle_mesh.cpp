@@ -10,7 +10,7 @@
 #include <set>
 
 #include "geometry/exact_measures.h"
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 #include "geometry/tip_geometry.h"
 #include "mesher/mesh_quality.h"
 #include "mesher/msh_file.h"

@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 #include "mesher/particle_lattice.h"
 
 using namespace needle;

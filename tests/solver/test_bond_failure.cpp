@@ -4,7 +4,7 @@
 #include <cmath>
 #include <numeric>
 
-#include "solver/explicit_dynamics.h"
+#include "solver/tissue/tissue_dynamics.h"
 #include "tests/solver/solver_fixtures.h"
 
 using namespace needle;

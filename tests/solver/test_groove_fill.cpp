@@ -3,7 +3,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
-#include "solver/groove_fill.h"
+#include "solver/insertion/groove_fill.h"
 
 using namespace needle;
 

@@ -10,7 +10,10 @@
 #include "geometry/grinding_recipe.h"
 #include "mesher/needle_mesher.h"
 #include "mesher/particle_lattice.h"
-#include "solver/lspg_insertion.h"
+#include "solver/insertion/coupled_insertion.h"
+#include "solver/needle/needle_models.h"
+#include "solver/separation/needle_bond_cut.h"
+#include "solver/separation/separation_models.h"
 
 using namespace needle;
 
@@ -36,22 +39,19 @@ struct Insertion {
   FeNeedle needle;
   ContactSurface surface;
   SpgTissue tissue;
-  NeedleDynamics dynamics;
-  LspgInsertion run;
+  std::unique_ptr<NeedleModel> model;  // the FE needle, or the rigid one
+  NeedleModel& dynamics;
+  CoupledInsertion run;
 
   Insertion(const TetMesh& mesh, double mass_scaling_dt_ms, bool rigid, const InsertionProfile& profile, const Eigen::Vector3d& direction,
             const ParticleSet& particles, const CouplingOptions& coupling, const ContactOptions& contact = {})
       : needle(mesh, NeedleMaterial{}, mass_scaling_dt_ms),
         surface(needle.mesh()),
         tissue(particles, TissueMaterial{}, SpgOptions{}),
-        dynamics(needle, driven_base_supports(needle.mesh(), profile, direction), std::nullopt, options(rigid)),
-        run(dynamics, tissue, surface, contact, coupling) {}
+        model(make_needle_model(rigid ? "rigid" : "fe", {needle, driven_base_supports(needle.mesh(), profile, direction), std::nullopt, {}})),
+        dynamics(*model),
+        run(dynamics, tissue, surface, contact, make_separation_models(SeparationOptions{}, surface), coupling) {}
 
-  static NeedleDynamicsOptions options(bool rigid) {
-    NeedleDynamicsOptions o;
-    o.rigid = rigid;
-    return o;
-  }
   void run_to_end() {
     const double end = dynamics_end();
     while (run.time_ms() < end - 1e-12) run.step(end);
@@ -106,10 +106,12 @@ TEST_CASE("A rigid needle driven into tissue with fixed sides balances energy wi
   // penalty lets a particle sink as far as its load over the stiffness, and the tissue the needle cuts
   // (71 bonds here) holds its particles less tightly than uncut tissue (there: none inside at all).
   const InsideReport inside = ins.run.contact_model().classify(ins.tissue.particles(), ins.dynamics.positions_mm());
-  INFO("deepest " << inside.max_depth_mm << " mm; bonds cut " << ins.run.bonds_cut_by_needle() << " broken " << ins.run.bonds_broken()
+  const auto& cut = dynamic_cast<const NeedleBondCut&>(*ins.run.separations().at(0));
+  INFO("deepest " << inside.max_depth_mm << " mm; bonds cut " << cut.bonds_cut() << " broken " << ins.run.bonds_broken()
                   << "; valid points " << ins.tissue.valid_integration_points() << " of " << ins.tissue.particles().size());
   CHECK(inside.max_depth_mm < ContactOptions{}.skin_mm);
-  CHECK(ins.run.bonds_cut_by_needle() > 0);
+  CHECK(cut.bonds_cut() > 0);
+  CHECK(cut.bonds_cut() == ins.tissue.bonds().cut_count);
 }
 
 TEST_CASE("A free tissue block hit by a driven needle conserves momentum within 2 %", "[solver][lspg][gmsh]") {

@@ -6,8 +6,8 @@
 
 #include "mesher/needle_mesher.h"
 #include "mesher/particle_lattice.h"
-#include "solver/needle_bond_cut.h"
-#include "solver/spg_tissue.h"
+#include "solver/separation/needle_bond_cut.h"
+#include "solver/tissue/spg_tissue.h"
 
 using namespace needle;
 

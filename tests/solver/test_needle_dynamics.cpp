@@ -5,12 +5,12 @@
 #include <cmath>
 
 #include "geometry/grinding_recipe.h"
-#include "geometry/input_error.h"
+#include "core/input_error.h"
 #include "mesher/needle_mesher.h"
-#include "solver/needle_dynamics.h"
-#include "solver/needle_statics.h"
-#include "solver/needle_stiffness.h"
-#include "solver/solver_error.h"
+#include "solver/needle/needle_dynamics.h"
+#include "solver/needle/needle_statics.h"
+#include "solver/needle/needle_stiffness.h"
+#include "core/solver_error.h"
 
 using namespace needle;
 

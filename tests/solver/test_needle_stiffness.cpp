@@ -8,8 +8,8 @@
 #include "geometry/grinding_recipe.h"
 #include "mesher/needle_mesher.h"
 #include "mesher/tet_element.h"
-#include "solver/fe_needle.h"
-#include "solver/needle_stiffness.h"
+#include "solver/needle/fe_needle.h"
+#include "solver/needle/needle_stiffness.h"
 
 using namespace needle;
 

@@ -4,7 +4,7 @@
 #include <catch2/catch.hpp>
 #include <random>
 
-#include "solver/rk_shape_functions.h"
+#include "solver/tissue/rk_shape_functions.h"
 #include "tests/solver/solver_fixtures.h"
 
 using namespace needle;

@@ -4,7 +4,7 @@
 #include <catch2/catch.hpp>
 #include <random>
 
-#include "solver/spg_tissue.h"
+#include "solver/tissue/spg_tissue.h"
 #include "tests/solver/solver_fixtures.h"
 
 using namespace needle;

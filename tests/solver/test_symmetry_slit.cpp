@@ -4,8 +4,8 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
-#include "solver/explicit_dynamics.h"
-#include "solver/symmetry_slit.h"
+#include "solver/tissue/tissue_dynamics.h"
+#include "solver/separation/symmetry_slit.h"
 #include "tests/solver/solver_fixtures.h"
 
 using namespace needle;

@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "solver/tip_crack.h"
+#include "solver/separation/tip_crack.h"
 
 using namespace needle;
 

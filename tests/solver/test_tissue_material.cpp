@@ -4,9 +4,9 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
-#include "geometry/input_error.h"
-#include "solver/spg_tissue.h"
-#include "solver/uniaxial_test.h"
+#include "core/input_error.h"
+#include "solver/tissue/spg_tissue.h"
+#include "solver/tissue/uniaxial_test.h"
 #include "tests/solver/solver_fixtures.h"
 
 using namespace needle;

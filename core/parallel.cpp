@@ -1,0 +1,36 @@
+#include "core/parallel.h"
+
+#include <memory>
+#include <tbb/blocked_range.h>
+#include <tbb/global_control.h>
+#include <tbb/info.h>
+#include <tbb/parallel_for.h>
+
+namespace needle {
+
+void parallel_for(std::int64_t n, const std::function<void(std::int64_t, std::int64_t)>& body) {
+  if (n <= 0) return;
+  constexpr std::int64_t kGrain = 512;
+  if (n <= kGrain) {
+    body(0, n);
+    return;
+  }
+  tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, n, kGrain),
+                    [&](const tbb::blocked_range<std::int64_t>& r) { body(r.begin(), r.end()); });
+}
+
+struct ThreadLimit::Impl {
+  std::unique_ptr<tbb::global_control> control;
+};
+
+ThreadLimit::ThreadLimit(int threads) : impl_(new Impl) {
+  if (threads > 0)
+    impl_->control = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                           static_cast<size_t>(threads));
+}
+
+ThreadLimit::~ThreadLimit() { delete impl_; }
+
+int hardware_threads() { return tbb::info::default_concurrency(); }
+
+}  // namespace needle

@@ -1,0 +1,94 @@
+#include "solver/insertion/coupled_insertion.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+
+#include "core/input_error.h"
+#include "core/solver_error.h"
+
+namespace needle {
+
+void CouplingOptions::validate(const std::string& where) const {
+  NEEDLE_REQUIRE(std::isfinite(max_step_ms) && max_step_ms >= 0, fmt::format("{}: max_step_ms must be zero or positive", where));
+  NEEDLE_REQUIRE(std::isfinite(contact_courant) && contact_courant > 0 && contact_courant <= 1,
+                 fmt::format("{}: contact_courant must lie in (0, 1]", where));
+  NEEDLE_REQUIRE(std::isfinite(max_energy_error) && max_energy_error > 0, fmt::format("{}: max_energy_error must be positive", where));
+  NEEDLE_REQUIRE(std::isfinite(max_depth_mm) && max_depth_mm > 0, fmt::format("{}: max_depth_mm must be positive", where));
+}
+
+CoupledInsertion::CoupledInsertion(NeedleModel& needle, SpgTissue& tissue, const ContactSurface& surface, const ContactOptions& contact,
+                                   std::vector<std::unique_ptr<SeparationModel>> separations, const CouplingOptions& coupling)
+    : needle_(needle),
+      tissue_(tissue),
+      options_(coupling),
+      tissue_dynamics_(tissue, {}, coupling.tissue_body_acceleration_mm_per_ms2),
+      contact_(surface, tissue.particles(), tissue.material(), contact),
+      separations_(std::move(separations)) {
+  options_.validate();
+  NEEDLE_REQUIRE(needle.steps() == 0 && needle.time_ms() == 0, "the coupled run must start with a needle at t = 0");
+  NEEDLE_REQUIRE(surface.reference_positions().rows() == needle.positions_mm().rows(), "the contact surface belongs to another needle mesh");
+  contact_.set_needle(needle.nodal_mass_g(), needle.time_step_ms());
+  // The contact at t = 0 (particles placed within the skin already push), on both bodies.
+  contact_.begin_step(tissue.particles(), needle.positions_mm(), needle.velocities_mm_per_ms(), 0.0,
+                      tissue_dynamics_.time_step_ms(options_.contact_courant * contact_.stable_time_step_ms()));
+  needle_.apply_loads(contact_);
+  contact_.last_particle_forces(contact_force_N_);
+  tissue_dynamics_.set_external_forces(contact_force_N_);
+  energy_.start(needle_.energy(), tissue_dynamics_.energy(), contact_);
+}
+
+void CoupledInsertion::step(double end_time_ms) {
+  const double t = time_ms();
+  const double dt = tissue_dynamics_.kick_and_drift(plan_time_step(end_time_ms));
+  contact_.begin_step(tissue_.particles(), needle_.positions_mm(), needle_.velocities_mm_per_ms(), t, dt);
+  needle_.advance_to(t + dt, contact_);
+  contact_.end_step(contact_force_N_);
+  tissue_dynamics_.finish_step(&contact_force_N_);
+  for (const std::unique_ptr<SeparationModel>& separation : separations_) separation->apply(tissue_, needle_);
+  ++steps_;
+  last_dt_ms_ = dt;
+  energy_.update(needle_.energy(), tissue_dynamics_.energy(), contact_);
+  check_health();
+}
+
+double CoupledInsertion::plan_time_step(double end_time_ms) const {
+  const double t = time_ms();
+  double cap = end_time_ms - t;
+  NEEDLE_REQUIRE(cap > 0, "the insertion has reached its end time");
+  if (options_.max_step_ms > 0) cap = std::min(cap, options_.max_step_ms);
+  cap = std::min(cap, options_.contact_courant * contact_.stable_time_step_ms());
+  const double needle_dt = needle_.time_step_ms();
+  if (!options_.subcycling) cap = std::min(cap, needle_dt);
+  double dt = tissue_dynamics_.time_step_ms(cap);
+  // A whole number of needle steps per coupling step, so that the needle never takes a sliver of a step.
+  if (std::isfinite(needle_dt) && dt > needle_dt && dt < end_time_ms - t) dt = std::floor(dt / needle_dt) * needle_dt;
+  return dt;
+}
+
+void CoupledInsertion::check_health() {
+  max_inside_ = std::max(max_inside_, contact_.report().particles_inside);
+  max_depth_ = std::max(max_depth_, contact_.report().max_depth_mm);
+  if (contact_.report().max_depth_mm > options_.max_depth_mm)
+    throw SolverError(fmt::format("runaway penetration: a tissue particle is {:.3g} mm inside the needle at t = {:.6g} ms (limit {:.3g} mm)",
+                                  contact_.report().max_depth_mm, time_ms(), options_.max_depth_mm));
+  // The balance is checked once the work done from outside exceeds a nanojoule and the energy the run
+  // started with (particles inside the contact's skin at t = 0 release theirs in the first steps, when
+  // the drive has done almost nothing: measured against that, the release is not a drift).
+  if (energy_.external_work_mJ() > std::max(1e-6, std::abs(energy_.initial_energy_mJ()))) {
+    const double error = energy_.balance_error();
+    max_energy_error_ = std::max(max_energy_error_, error);
+    if (error > options_.max_energy_error)
+      throw SolverError(fmt::format("the insertion's energy balance drifted by {:.3g} % at t = {:.6g} ms (limit {:.3g} %)", 100 * error,
+                                    time_ms(), 100 * options_.max_energy_error));
+  }
+}
+
+Eigen::Vector3d CoupledInsertion::tissue_momentum() const {
+  const TissueParticles& p = tissue_.particles();
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (std::int64_t i = 0; i < p.size(); ++i) sum += p.mass_g[static_cast<size_t>(i)] * p.velocity_mm_per_ms[static_cast<size_t>(i)];
+  return sum;
+}
+
+}  // namespace needle

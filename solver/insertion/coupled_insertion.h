@@ -1,0 +1,93 @@
+#pragma once
+// The L-SPG insertion: a needle model (needle/needle_model.h: the FE needle, or the rigid one) driven into
+// the SPG tissue (tissue/spg_tissue.h, tissue/tissue_dynamics.h) through the frictional penalty contact
+// (contact/needle_tissue_contact.h), the tissue separated after each step by the scene's separation models
+// (separation/separation_models.h), in one explicit run with two clocks. The coupled step, as step() reads:
+//   1. plan dt: the tissue's stable step, capped by the contact's (contact_courant of its own limit) and
+//      the end time, rounded down to whole needle steps;
+//   2. the tissue's first half of velocity Verlet: half kick and drift to its end positions;
+//   3. the contact begins the step: geometry from both bodies (particles at their end, needle at its start);
+//   4. the needle advances to t + dt under the contact's loads, subcycling at its own step (the contact's
+//      gap is updated from both bodies' motion at every needle step);
+//   5. the contact ends the step: its force at t + dt on the particles;
+//   6. the tissue's second half: its forces at t + dt with the contact's, the half kick;
+//   7. each separation model separates the tissue (the needle's cut, the slit, the crack);
+//   8. the energy account, penetration and drift checks (each body checks its own NaN and blow-up).
+// Each step, the needle receives -C(t) over its substeps and the tissue (C(t) + C(t + dt)) dt / 2: momentum
+// is exchanged exactly up to a half-step lag that never accumulates (it telescopes to dt/2 |C(end) - C(0)|).
+// The lag is stable because the steel's response to a force within one tissue step is tiny next to the
+// contact's own stiffness (the loop gain is k_contact / K_steel, about 1e-3). With subcycling off, both
+// bodies take the needle's step: the plain full model the subcycled one is measured against (bench_insertion).
+// The run stops with a SolverError (never NaN) on non-finite state, runaway penetration, time-step collapse
+// or energy drift (insertion_energy.h).
+#include <Eigen/Dense>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "solver/contact/needle_tissue_contact.h"
+#include "solver/insertion/insertion_energy.h"
+#include "solver/needle/needle_model.h"
+#include "solver/separation/separation_model.h"
+#include "solver/tissue/tissue_dynamics.h"
+
+namespace needle {
+
+struct CouplingOptions {
+  bool subcycling = true;       // false: the tissue takes the needle's step (plain full model)
+  double max_step_ms = 0.0;     // cap on the coupling step (0: the tissue's and the contact's limits only)
+  double contact_courant = 0.1; // fraction of the contact's own stable step (2 sqrt(m/k)) a coupling step may
+                                // take: the accuracy knob of the subcycling (its error is first order in it)
+  double max_energy_error = 0.05;    // stop when the physical balance drifts beyond this (once the work from outside exceeds the energy at t = 0)
+  double max_depth_mm = 0.3;         // stop when a particle gets this deep inside the needle
+  Eigen::Vector3d tissue_body_acceleration_mm_per_ms2 = Eigen::Vector3d::Zero();  // e.g. to press a block on
+  void validate(const std::string& where = "coupling") const;
+};
+
+class CoupledInsertion {
+ public:
+  // The needle, the tissue and the surface are advanced or read by this object; they must outlive it.
+  CoupledInsertion(NeedleModel& needle, SpgTissue& tissue, const ContactSurface& surface, const ContactOptions& contact,
+                   std::vector<std::unique_ptr<SeparationModel>> separations, const CouplingOptions& coupling);
+
+  // One coupling step, shortened to land on end_time_ms.
+  void step(double end_time_ms);
+
+  double time_ms() const { return tissue_dynamics_.time_ms(); }
+  long steps() const { return steps_; }
+  double last_step_ms() const { return last_dt_ms_; }
+  long needle_steps() const { return needle_.steps(); }
+  const ContactReport& contact() const { return contact_.report(); }
+  NeedleTissueContact& contact_model() { return contact_; }
+  const NeedleTissueContact& contact_model() const { return contact_; }
+  const InsertionEnergy& energy() const { return energy_; }
+  double max_energy_error() const { return max_energy_error_; }
+  int max_particles_inside() const { return max_inside_; }
+  double max_depth_mm() const { return max_depth_; }
+  long bonds_broken() const { return static_cast<long>(tissue_.bonds().broken_count); }
+  const std::vector<std::unique_ptr<SeparationModel>>& separations() const { return separations_; }
+  // Momenta (g mm/ms).
+  Eigen::Vector3d tissue_momentum() const;
+  Eigen::Vector3d needle_momentum() const { return needle_.momentum(); }
+  const NeedleModel& needle() const { return needle_; }
+  const SpgTissue& tissue() const { return tissue_; }
+  const TissueDynamics& tissue_dynamics() const { return tissue_dynamics_; }
+
+ private:
+  double plan_time_step(double end_time_ms) const;
+  void check_health();  // penetration and the energy balance; SolverError beyond their limits
+
+  NeedleModel& needle_;
+  SpgTissue& tissue_;
+  CouplingOptions options_;
+  TissueDynamics tissue_dynamics_;
+  NeedleTissueContact contact_;
+  std::vector<std::unique_ptr<SeparationModel>> separations_;
+  std::vector<Vec3d> contact_force_N_;  // the contact's force on each particle at the step's end
+  InsertionEnergy energy_;
+  double last_dt_ms_ = 0, max_energy_error_ = 0, max_depth_ = 0;
+  int max_inside_ = 0;
+  long steps_ = 0;
+};
+
+}  // namespace needle

@@ -1,0 +1,29 @@
+#pragma once
+// The coupled run's energy account. The bodies' balances hold on their own; the run's physical balance is
+//   W_drive + W_cannula = dKE + dU_needle + E_tissue (stored + plastic, -W_model) + E_penalty + D_friction,
+// with E_penalty and D_friction from the contact law, not from the forces' work, so a contact that
+// creates or destroys energy (lag, sticking) shows up as balance error.
+#include "solver/contact/needle_tissue_contact.h"
+#include "solver/needle/needle_model.h"
+#include "solver/tissue/tissue_dynamics.h"
+
+namespace needle {
+
+struct InsertionEnergy {
+  double tissue_kinetic_mJ = 0, tissue_internal_mJ = 0;  // internal: stored + plastically dissipated (-W_model)
+  double needle_kinetic_mJ = 0, needle_strain_mJ = 0, needle_initial_mJ = 0, tissue_initial_kinetic_mJ = 0;
+  double drive_work_mJ = 0, cannula_work_mJ = 0, tissue_reaction_work_mJ = 0, body_work_mJ = 0;
+  double contact_work_mJ = 0;  // work of the contact forces on both bodies (should equal -(E_penalty + D_friction))
+  double relinearisation_energy_mJ = 0;  // the contact's penalty jumps at geometry updates (diagnostic, not in the balance)
+  double penalty_energy_mJ = 0, initial_penalty_energy_mJ = 0, friction_dissipation_mJ = 0;  // initial: overlaps at t = 0
+
+  // The account at t = 0 (the energy present then), and its terms now.
+  void start(const NeedleEnergy& needle, const EnergyBalance& tissue, const NeedleTissueContact& contact);
+  void update(const NeedleEnergy& needle, const EnergyBalance& tissue, const NeedleTissueContact& contact);
+  // |inputs - stored - dissipated| / the largest term (the energy at t = 0 among them)
+  double balance_error() const;
+  double initial_energy_mJ() const;  // kinetic, strain and penalty energy at t = 0
+  double external_work_mJ() const;   // the largest of the drive's, cannula's, supports' and body load's work
+};
+
+}  // namespace needle

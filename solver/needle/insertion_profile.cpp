@@ -1,0 +1,51 @@
+#include "solver/needle/insertion_profile.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+
+#include "core/input_error.h"
+
+namespace needle {
+
+void InsertionProfile::validate(const std::string& where) const {
+  NEEDLE_REQUIRE(std::isfinite(accel_time_ms) && accel_time_ms >= 0,
+                 fmt::format("{}: accel_time_ms must be zero or positive (got {})", where, accel_time_ms));
+  NEEDLE_REQUIRE(std::isfinite(speed_mm_per_ms) && speed_mm_per_ms > 0,
+                 fmt::format("{}: the insertion speed must be positive (got {} m/s)", where, speed_mm_per_ms));
+  NEEDLE_REQUIRE(std::isfinite(travel_mm) && travel_mm > 0, fmt::format("{}: travel_mm must be positive (got {})", where, travel_mm));
+  NEEDLE_REQUIRE(std::isfinite(decel_time_ms) && decel_time_ms >= 0,
+                 fmt::format("{}: decel_time_ms must be zero or positive (got {})", where, decel_time_ms));
+  NEEDLE_REQUIRE(std::isfinite(hold_ms) && hold_ms >= 0, fmt::format("{}: hold_ms must be zero or positive (got {})", where, hold_ms));
+  const double ramps_mm = 0.5 * speed_mm_per_ms * (accel_time_ms + decel_time_ms);
+  NEEDLE_REQUIRE(travel_mm >= ramps_mm, fmt::format("{}: travel {} mm ends before the speed is reached ({} mm of ramps)", where,
+                                                    travel_mm, ramps_mm));
+}
+
+double InsertionProfile::cruise_end_time_ms() const {
+  return accel_time_ms + (travel_mm - 0.5 * speed_mm_per_ms * (accel_time_ms + decel_time_ms)) / speed_mm_per_ms;
+}
+
+double InsertionProfile::travel_end_time_ms() const { return cruise_end_time_ms() + decel_time_ms; }
+
+double InsertionProfile::end_time_ms() const { return travel_end_time_ms() + hold_ms; }
+
+double InsertionProfile::velocity_mm_per_ms(double t) const {
+  const double stop = travel_end_time_ms();
+  if (t <= 0 || t > stop) return 0.0;  // without a deceleration, still moving at the end of the travel
+  if (t < accel_time_ms) return speed_mm_per_ms * t / accel_time_ms;
+  if (t <= cruise_end_time_ms()) return speed_mm_per_ms;
+  return speed_mm_per_ms * (stop - t) / decel_time_ms;
+}
+
+double InsertionProfile::displacement_mm(double t) const {
+  t = std::clamp(t, 0.0, travel_end_time_ms());
+  if (t < accel_time_ms) return 0.5 * speed_mm_per_ms * t * t / accel_time_ms;
+  const double cruise_end = cruise_end_time_ms();
+  const double at_cruise = 0.5 * speed_mm_per_ms * accel_time_ms + speed_mm_per_ms * (std::min(t, cruise_end) - accel_time_ms);
+  if (t <= cruise_end) return at_cruise;
+  const double s = t - cruise_end;  // into the deceleration
+  return at_cruise + speed_mm_per_ms * s - 0.5 * speed_mm_per_ms * s * s / decel_time_ms;
+}
+
+}  // namespace needle

@@ -1,0 +1,48 @@
+#include "solver/needle/needle_models.h"
+
+#include <fmt/format.h>
+
+#include "core/input_error.h"
+#include "solver/needle/rigid_needle.h"
+
+namespace needle {
+namespace {
+
+std::unique_ptr<NeedleModel> make_fe(const NeedleModelInputs& in) {
+  return std::make_unique<NeedleDynamics>(in.needle, in.supports, in.cannula, in.options);
+}
+
+std::unique_ptr<NeedleModel> make_rigid(const NeedleModelInputs& in) {
+  return std::make_unique<RigidNeedle>(in.needle, in.supports.profile, in.supports.direction, in.options.max_energy_error);
+}
+
+std::string known_names() {
+  std::string names;
+  for (const NeedleModelEntry& m : needle_models()) names += (names.empty() ? "" : ", ") + m.name;
+  return names;
+}
+
+}  // namespace
+
+const std::vector<NeedleModelEntry>& needle_models() {
+  static const std::vector<NeedleModelEntry> models = {
+      {"fe", "explicit T4/T10 finite elements with the driven base and the rigid cannula, subcycled in the tissue's step", make_fe},
+      {"rigid", "every node follows the drive: no deflection, no cannula, no step limit", make_rigid},
+  };
+  return models;
+}
+
+void require_needle_model(const std::string& name, const std::string& where) {
+  for (const NeedleModelEntry& m : needle_models())
+    if (m.name == name) return;
+  throw InputError(fmt::format("{}: unknown needle model '{}' (known: {})", where, name, known_names()));
+}
+
+std::unique_ptr<NeedleModel> make_needle_model(const std::string& name, const NeedleModelInputs& inputs) {
+  for (const NeedleModelEntry& m : needle_models())
+    if (m.name == name) return m.make(inputs);
+  require_needle_model(name, "needle.model");
+  return nullptr;
+}
+
+}  // namespace needle

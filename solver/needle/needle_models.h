@@ -1,0 +1,34 @@
+#pragma once
+// The needle models by name: what a scene's needle.model selects (docs/architecture.md). Each is one
+// file implementing NeedleModel and one line in needle_models.cpp.
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "solver/needle/needle_dynamics.h"
+#include "solver/needle/needle_model.h"
+
+namespace needle {
+
+// What any needle model may be built from; the FE needle and the supports must outlive the model.
+struct NeedleModelInputs {
+  const FeNeedle& needle;
+  NeedleSupports supports;               // the driven base, the symmetry plane and the insertion profile
+  std::optional<CannulaOptions> cannula;  // absent: no cannula
+  NeedleDynamicsOptions options;
+};
+
+struct NeedleModelEntry {
+  std::string name, description;
+  std::unique_ptr<NeedleModel> (*make)(const NeedleModelInputs& inputs);
+};
+
+// The registered models, in the order --help lists them.
+const std::vector<NeedleModelEntry>& needle_models();
+// The model registered as name; InputError listing the known names otherwise.
+std::unique_ptr<NeedleModel> make_needle_model(const std::string& name, const NeedleModelInputs& inputs);
+// InputError unless name is registered (scene readers check before building anything).
+void require_needle_model(const std::string& name, const std::string& where);
+
+}  // namespace needle

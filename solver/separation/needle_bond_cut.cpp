@@ -1,0 +1,150 @@
+#include "solver/separation/needle_bond_cut.h"
+
+#include <chrono>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+
+namespace needle {
+
+// The needle's current triangles (for a half model with the mirror images of those that touch the
+// symmetry plane) binned in a uniform grid over their bounding box: CSR over cells.
+struct NeedleBondCut::Grid {
+  std::vector<std::array<Eigen::Vector3d, 3>> triangles;
+  Eigen::Vector3d lo = Eigen::Vector3d::Zero(), hi = Eigen::Vector3d::Zero();
+  Eigen::Vector3i cells = Eigen::Vector3i::Zero();
+  double cell_mm = 1;
+  std::vector<int> start, entries;
+
+  Eigen::Vector3i cell_of(const Eigen::Vector3d& p) const {
+    Eigen::Vector3i c = ((p - lo) / cell_mm).array().floor().cast<int>();
+    return c.cwiseMax(0).cwiseMin(cells - Eigen::Vector3i::Ones());
+  }
+  int index(int i, int j, int k) const { return (i * cells.y() + j) * cells.z() + k; }
+};
+
+namespace {
+
+constexpr double kBarycentricTolerance = 1e-9;  // a segment through a shared edge or the seam still hits
+constexpr double kDistinctCrossing = 1e-7;      // crossings closer than this (in s) are the same point
+
+// Parameter s in [0, 1] where a + s (b - a) meets triangle t (Moeller-Trumbore), or NaN.
+double segment_triangle(const Eigen::Vector3d& a, const Eigen::Vector3d& d, const std::array<Eigen::Vector3d, 3>& t) {
+  const Eigen::Vector3d e1 = t[1] - t[0], e2 = t[2] - t[0];
+  const Eigen::Vector3d q = d.cross(e2);
+  const double det = e1.dot(q);
+  const double scale = e1.norm() * e2.norm() * d.norm();
+  if (!(std::abs(det) > 1e-12 * scale)) return std::nan("");  // parallel to the triangle's plane
+  const double inv = 1.0 / det;
+  const Eigen::Vector3d w = a - t[0];
+  const double u = w.dot(q) * inv;
+  if (u < -kBarycentricTolerance || u > 1 + kBarycentricTolerance) return std::nan("");
+  const Eigen::Vector3d r = w.cross(e1);
+  const double v = d.dot(r) * inv;
+  if (v < -kBarycentricTolerance || u + v > 1 + kBarycentricTolerance) return std::nan("");
+  const double s = e2.dot(r) * inv;
+  if (s < -kBarycentricTolerance || s > 1 + kBarycentricTolerance) return std::nan("");
+  return std::clamp(s, 0.0, 1.0);
+}
+
+}  // namespace
+
+NeedleBondCut::NeedleBondCut(const ContactSurface& surface) : surface_(surface) {}
+
+NeedleBondCut::Grid NeedleBondCut::build_grid(const Eigen::MatrixX3d& needle_x) const {
+  Grid grid;
+  const Eigen::MatrixX3i& tris = surface_.triangles();
+  grid.triangles.reserve(static_cast<size_t>(tris.rows()));
+  const Eigen::Vector3d lo = needle_x.colwise().minCoeff(), hi = needle_x.colwise().maxCoeff();
+  const double plane_tol = 1e-9 * std::max(1.0, (hi - lo).norm());
+  double extent_sum = 0;
+  for (Eigen::Index t = 0; t < tris.rows(); ++t) {
+    std::array<Eigen::Vector3d, 3> v;
+    for (int k = 0; k < 3; ++k) v[static_cast<size_t>(k)] = needle_x.row(tris(t, k)).transpose();
+    grid.triangles.push_back(v);
+    const Eigen::Vector3d tlo = v[0].cwiseMin(v[1]).cwiseMin(v[2]), thi = v[0].cwiseMax(v[1]).cwiseMax(v[2]);
+    extent_sum += (thi - tlo).maxCoeff();
+    // The mirror image closes a half model's surface; only triangles on the plane can meet a segment
+    // that stays on the model's side (z >= 0).
+    if (surface_.half_model() && tlo.z() <= plane_tol) {
+      std::array<Eigen::Vector3d, 3> m = v;
+      for (auto& p : m) p.z() = -p.z();
+      grid.triangles.push_back(m);
+    }
+  }
+  grid.cell_mm = std::max(1.5 * extent_sum / static_cast<double>(tris.rows()), 1e-3);
+  grid.lo = lo;
+  grid.hi = hi;
+  if (surface_.half_model()) grid.lo.z() = std::min(lo.z(), -hi.z());
+  grid.lo.array() -= grid.cell_mm;
+  grid.hi.array() += grid.cell_mm;
+  grid.cells = ((grid.hi - grid.lo) / grid.cell_mm).array().ceil().cast<int>().cwiseMax(1);
+  const int count = grid.cells.prod();
+  std::vector<std::pair<int, int>> cell_triangle;
+  for (size_t t = 0; t < grid.triangles.size(); ++t) {
+    const auto& v = grid.triangles[t];
+    const Eigen::Vector3i c0 = grid.cell_of(v[0].cwiseMin(v[1]).cwiseMin(v[2]));
+    const Eigen::Vector3i c1 = grid.cell_of(v[0].cwiseMax(v[1]).cwiseMax(v[2]));
+    for (int i = c0.x(); i <= c1.x(); ++i)
+      for (int j = c0.y(); j <= c1.y(); ++j)
+        for (int k = c0.z(); k <= c1.z(); ++k) cell_triangle.emplace_back(grid.index(i, j, k), static_cast<int>(t));
+  }
+  std::sort(cell_triangle.begin(), cell_triangle.end());
+  grid.start.assign(static_cast<size_t>(count + 1), 0);
+  grid.entries.reserve(cell_triangle.size());
+  for (const auto& [cell, t] : cell_triangle) {
+    ++grid.start[static_cast<size_t>(cell + 1)];
+    grid.entries.push_back(t);
+  }
+  for (size_t c = 1; c < grid.start.size(); ++c) grid.start[c] += grid.start[c - 1];
+  return grid;
+}
+
+std::vector<double> NeedleBondCut::crossings(const Grid& grid, const Eigen::Vector3d& a, const Eigen::Vector3d& b) const {
+  std::vector<double> s;
+  const Eigen::Vector3d lo = a.cwiseMin(b), hi = a.cwiseMax(b);
+  if ((hi.array() < grid.lo.array()).any() || (lo.array() > grid.hi.array()).any()) return s;
+  const Eigen::Vector3i c0 = grid.cell_of(lo), c1 = grid.cell_of(hi);
+  const Eigen::Vector3d d = b - a;
+  for (int i = c0.x(); i <= c1.x(); ++i)
+    for (int j = c0.y(); j <= c1.y(); ++j)
+      for (int k = c0.z(); k <= c1.z(); ++k) {
+        const int cell = grid.index(i, j, k);
+        for (int e = grid.start[static_cast<size_t>(cell)]; e < grid.start[static_cast<size_t>(cell + 1)]; ++e) {
+          const double hit = segment_triangle(a, d, grid.triangles[static_cast<size_t>(grid.entries[static_cast<size_t>(e)])]);
+          if (!std::isnan(hit)) s.push_back(hit);
+        }
+      }
+  std::sort(s.begin(), s.end());
+  s.erase(std::unique(s.begin(), s.end(), [](double x, double y) { return y - x < kDistinctCrossing; }), s.end());
+  return s;
+}
+
+std::vector<double> NeedleBondCut::surface_crossings(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                                     const Eigen::MatrixX3d& needle_x) const {
+  return crossings(build_grid(needle_x), a, b);
+}
+
+std::vector<std::int64_t> NeedleBondCut::bonds_through_needle(const BondNetwork& bonds, const std::vector<Vec3d>& x,
+                                                              const Eigen::MatrixX3d& needle_x) const {
+  const Grid grid = build_grid(needle_x);
+  return select_intact_bonds(bonds, [&](const Bond& bond) {
+    return crossings(grid, x[static_cast<size_t>(bond.i)], x[static_cast<size_t>(bond.j)]).size() >= 2;
+  });
+}
+
+void NeedleBondCut::apply(SpgTissue& tissue, const NeedleModel& needle) {
+  const auto start = std::chrono::steady_clock::now();
+  cut_ += tissue.cut_bonds(bonds_through_needle(tissue.bonds(), tissue.particles().position_mm, needle.positions_mm()));
+  wall_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void NeedleBondCut::add_summary(nlohmann::json& summary, const SpgTissue&) const {
+  summary["bonds_cut_by_needle"] = cut_;
+  summary["bond_cut_s"] = wall_s_;
+}
+
+}  // namespace needle

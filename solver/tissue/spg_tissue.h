@@ -1,0 +1,122 @@
+#pragma once
+// The SPG tissue: particles with RK shape functions, direct nodal integration, displacement-smoothing
+// stabilization, MAT_018-style plasticity and bond failure. It computes forces from positions; the
+// integrator (explicit_dynamics.h) advances it.
+//
+// Kinematics: F_i = sum_j x_j (x) grad Psi_j(X_i) over the kernel's reference X. Stress: Cauchy,
+// updated from the relative deformation gradient F_n+1 F_n^-1 of the step (tissue_material.h). Force on particle j:
+//   f_j = - sum_i V_i P_i grad Psi_j(X_i) + stabilization,   P = J sigma F^-T (first Piola-Kirchhoff),
+// gathered through the transposed shape functions, so results do not depend on the thread count.
+#include <Eigen/Dense>
+#include <cstdint>
+#include <vector>
+
+#include "mesher/particle_lattice.h"
+#include "solver/tissue/bond_network.h"
+#include "solver/tissue/rk_shape_functions.h"
+#include "solver/tissue/spg_options.h"
+#include "solver/tissue/tissue_material.h"
+
+namespace needle {
+
+using Vec3d = Eigen::Vector3d;
+using Mat3d = Eigen::Matrix3d;
+
+// Particle fields, one entry per particle (structure of arrays).
+struct TissueParticles {
+  std::vector<Vec3d> reference_mm;        // kernel reference positions X (reset by kernel re-initialisation)
+  std::vector<Vec3d> initial_mm;          // positions at t = 0 (displacement output)
+  std::vector<Vec3d> position_mm;
+  std::vector<Vec3d> velocity_mm_per_ms;
+  std::vector<Vec3d> force_N;             // internal + stabilization force of the last evaluation
+  std::vector<double> mass_g;
+  std::vector<double> reference_volume_mm3;
+  std::vector<double> spacing_mm;
+  std::vector<double> support_radius_mm;
+  std::vector<std::uint8_t> flags;        // ParticleFlag bits
+  std::vector<Mat3d> deformation_gradient;  // relative to the kernel reference
+  std::vector<Mat3d> stress_MPa;            // Cauchy
+  std::vector<Mat3d> elastic_left_cauchy_green;  // b_e of the material (see tissue_material.h)
+  std::vector<double> plastic_strain;
+  std::vector<Mat3d> relaxed_stress_MPa;    // the Maxwell branch's q (empty unless the material is viscoelastic)
+  std::vector<Mat3d> elastic_deviator_MPa;  // s_e of the last update (empty unless viscoelastic)
+  std::vector<double> effective_strain;   // eps_p + equivalent elastic log strain (StressUpdate)
+  std::vector<double> defect_mm;          // |g_i|, the smoothing defect (zero-energy-mode indicator)
+  std::int64_t size() const { return static_cast<std::int64_t>(position_mm.size()); }
+};
+
+struct ForceReport {
+  std::int64_t bonds_broken_now = 0;
+  std::int64_t rate_factor_capped = 0;  // evaluations where the rate factor hit its cap
+  std::int64_t particles_detached_now = 0;  // crack-face particles whose support collapsed (now free)
+};
+
+class SpgTissue {
+ public:
+  // InputError for a bad material, bad options, or particles that cannot carry shape functions.
+  SpgTissue(const ParticleSet& particles, const TissueMaterial& material, const SpgOptions& options);
+
+  // Forces at the current positions; dt_ms is the increment since the last call (0: first call, no
+  // stress update). Then breaks the bonds that reached the failure criterion and rebuilds their rows.
+  // SolverError on an inverted or non-finite particle.
+  ForceReport compute_forces(double dt_ms);
+
+  // Breaks the given bonds (indices into bonds(); already broken ones are skipped) whatever the strains
+  // say, e.g. where the needle's body separates their particles (needle_bond_cut.h), and rebuilds their
+  // rows as break_bonds does. Returns how many it broke; they count in bonds().broken_count and cut_count.
+  std::int64_t cut_bonds(const std::vector<std::int64_t>& bond_indices);
+
+  // The smallest current spacing over the dilatational wave speed (with stabilization stiffness), x cfl.
+  double stable_time_step_ms() const;
+
+  // Called by the integrator once per step (counts steps for the filter and the kernel update).
+  void end_of_step();
+
+  double stabilization_energy_mJ() const;
+  std::int64_t valid_integration_points() const;
+  // Whether particle i is still an integration point (false once detached: a free mass point).
+  bool is_integration_point(std::int64_t i) const { return rk_.valid[static_cast<size_t>(i)] != 0; }
+
+  TissueParticles& particles() { return p_; }
+  const TissueParticles& particles() const { return p_; }
+  const TissueMaterial& material() const { return material_; }
+  const SpgOptions& options() const { return options_; }
+  const RkShapeFunctions& shape_functions() const { return rk_; }
+  const BondNetwork& bonds() const { return bonds_; }
+
+ private:
+  void build_kernel();
+  void update_stable_lengths();
+  void apply_filter();
+  void reinitialize_kernel();
+  std::int64_t break_bonds();
+  // Marks the bonds flagged in breaking (1: cut, 2: dead, no live row changes) broken and rebuilds the rows
+  // of their particles; the count of those newly broken.
+  std::int64_t separate(const std::vector<std::uint8_t>& breaking);
+  // Whether a crack-face particle's support still measures a volume (SpgOptions::crack_face_min_volume_ratio).
+  bool crack_face_support_holds(const Mat3d& F, double J) const;
+  // Particle s stops being an integration point: its row, smoothing defect and stress are cleared; it
+  // moves on as a free mass point.
+  void detach(size_t s);
+  // An unloaded material at s: b_e = I and, if viscoelastic, no Maxwell stress (the particle stopped being
+  // an integration point).
+  void reset_material_state(size_t s);
+  void refresh_reference_matrix();
+
+  TissueParticles p_;
+  TissueMaterial material_;
+  SpgOptions options_;
+  RkShapeFunctions rk_;
+  BondNetwork bonds_;
+  std::vector<double> stiffness_;  // kappa_i of the penalty
+  std::vector<double> stable_length_mm_;  // min(spacing, nearest neighbour distance) in the kernel reference
+  std::vector<double> min_stretch_;       // smallest principal stretch of F, kept by compute_forces
+  std::vector<std::uint8_t> point_status_;  // scratch flags of compute_forces
+  Eigen::MatrixX3d reference_;            // #P by 3 copy of reference_mm for the shape-function builders
+  std::vector<Vec3d> defect_;      // g_i
+  std::vector<Mat3d> piola_volume_;  // V_i P_i
+  std::int64_t steps_ = 0;
+  std::int64_t detached_on_rebuild_ = 0;  // crack-face particles separate() detached (counted into ForceReport)
+};
+
+}  // namespace needle

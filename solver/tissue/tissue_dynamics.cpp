@@ -1,0 +1,223 @@
+#include "solver/tissue/tissue_dynamics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+
+#include "core/input_error.h"
+#include "core/parallel.h"
+#include "core/solver_error.h"
+
+namespace needle {
+namespace {
+constexpr double kOnPlaneMm = 1e-9;  // an open symmetry particle this close to z = 0 rests on the plane
+}  // namespace
+
+double EnergyBalance::relative_error() const {
+  const double residual = kinetic_mJ - initial_kinetic_mJ - model_work_mJ - body_work_mJ - external_work_mJ - constraint_work_mJ;
+  const double scale = std::max({std::abs(kinetic_mJ), std::abs(initial_kinetic_mJ), std::abs(model_work_mJ),
+                                 std::abs(body_work_mJ), std::abs(external_work_mJ), std::abs(constraint_work_mJ), 1e-300});
+  return std::abs(residual) / scale;
+}
+
+TissueDynamics::TissueDynamics(SpgTissue& tissue, std::vector<VelocityConstraint> constraints,
+                               const Eigen::Vector3d& body_acceleration)
+    : tissue_(tissue), constraints_(std::move(constraints)), body_acceleration_(body_acceleration) {
+  const TissueParticles& p = tissue_.particles();
+  for (const VelocityConstraint& c : constraints_) {
+    NEEDLE_REQUIRE(c.axis >= 0 && c.axis < 3, "velocity constraint axis must be 0, 1 or 2");
+    NEEDLE_REQUIRE(static_cast<bool>(c.velocity_mm_per_ms), "velocity constraint without a velocity function");
+    NEEDLE_REQUIRE(c.scale.empty() || c.scale.size() == c.particles.size(), "velocity constraint scale needs one value per particle");
+    for (std::int32_t i : c.particles) NEEDLE_REQUIRE(i >= 0 && i < p.size(), "velocity constraint names a particle that does not exist");
+  }
+  NEEDLE_REQUIRE(body_acceleration.allFinite(), "body acceleration must be finite");
+  constrained_mask_.assign(static_cast<size_t>(p.size()), 0);
+  for (std::int64_t i = 0; i < p.size(); ++i) {
+    const std::uint8_t f = p.flags[static_cast<size_t>(i)];
+    if (f & kParticleFixed) constrained_mask_[static_cast<size_t>(i)] = 7;
+    else if (f & kParticleSymmetry) constrained_mask_[static_cast<size_t>(i)] |= 4;
+  }
+  for (const VelocityConstraint& c : constraints_)
+    for (std::int32_t i : c.particles) constrained_mask_[static_cast<size_t>(i)] |= static_cast<std::uint8_t>(1 << c.axis);
+  for (std::int64_t i = 0; i < p.size(); ++i)
+    if (constrained_mask_[static_cast<size_t>(i)]) constrained_.push_back(static_cast<std::int32_t>(i));
+  constrained_velocity_before_.resize(constrained_.size());
+  constrained_velocity_half_.resize(constrained_.size());
+  displacement_.resize(static_cast<size_t>(p.size()));
+  external_force_.assign(static_cast<size_t>(p.size()), Vec3d::Zero());
+  tissue_.compute_forces(0.0);
+  acceleration_.resize(static_cast<size_t>(p.size()));
+  for (std::int64_t i = 0; i < p.size(); ++i)
+    acceleration_[static_cast<size_t>(i)] = p.force_N[static_cast<size_t>(i)] / p.mass_g[static_cast<size_t>(i)] + body_acceleration_;
+  apply_constraints(tissue_.particles().velocity_mm_per_ms, 0.0, 0.0);
+  energy_.initial_kinetic_mJ = energy_.kinetic_mJ = kinetic_energy_mJ();
+}
+
+void TissueDynamics::apply_constraints(std::vector<Vec3d>& v, double time_ms, double drift_dt_ms) {
+  const TissueParticles& p = tissue_.particles();
+  if (drift_dt_ms == 0) {
+    // After the drift, the particles that landed this step and still move down are stopped below; that
+    // second impulse's work, corrected as the first's.
+    for (const Landing& l : landed_) {
+      const size_t s = static_cast<size_t>(l.particle);
+      const double before = v[s].z();
+      if (p.position_mm[s].z() <= kOnPlaneMm && before < 0)
+        impact_work_correction_mJ_ += -0.5 * p.mass_g[s] * before * before + p.mass_g[s] * before * l.v_half_z;
+    }
+  }
+  for (std::int64_t i = 0; i < p.size(); ++i) {
+    const size_t s = static_cast<size_t>(i);
+    const std::uint8_t f = p.flags[s];
+    if (f & kParticleFixed) v[s].setZero();
+    else if (f & kParticleOpenSymmetry) {
+      // z >= 0. On the plane the particle is held as a symmetry particle is (v_z >= 0 instead of = 0);
+      // above it, a drift that would cross the plane ends on it: an impact, whose impulses J = m dv do the
+      // work J (v_before + v_after) / 2 where the reactions' sum in step() books J v_half (the drift's).
+      const double z = p.position_mm[s].z();
+      if (drift_dt_ms > 0) {
+        const double landing = -z / drift_dt_ms;
+        if (z > kOnPlaneMm && v[s].z() < landing) {
+          const double jump = landing - v[s].z();
+          impact_work_correction_mJ_ -= 0.5 * p.mass_g[s] * jump * jump;
+          landed_.push_back({static_cast<std::int32_t>(i), landing});
+        }
+        v[s].z() = std::max(v[s].z(), landing);
+      } else if (z <= kOnPlaneMm) {
+        v[s].z() = std::max(v[s].z(), 0.0);
+      }
+    } else if (f & kParticleSymmetry) v[s].z() = 0.0;
+  }
+  for (const VelocityConstraint& c : constraints_) {
+    const double value = c.velocity_mm_per_ms(time_ms);
+    for (size_t k = 0; k < c.particles.size(); ++k)
+      v[static_cast<size_t>(c.particles[k])][c.axis] = c.scale.empty() ? value : value * c.scale[k];
+  }
+}
+
+double TissueDynamics::kinetic_energy_mJ() const {
+  const TissueParticles& p = tissue_.particles();
+  double ke = 0;
+  for (std::int64_t i = 0; i < p.size(); ++i)
+    ke += 0.5 * p.mass_g[static_cast<size_t>(i)] * p.velocity_mm_per_ms[static_cast<size_t>(i)].squaredNorm();
+  return ke;
+}
+
+void TissueDynamics::set_external_forces(const std::vector<Vec3d>& force_N) {
+  TissueParticles& p = tissue_.particles();
+  NEEDLE_REQUIRE(force_N.size() == static_cast<size_t>(p.size()), "external forces need one force per particle");
+  NEEDLE_REQUIRE(!drifted_, "external forces are set between steps, not inside one");
+  external_force_ = force_N;
+  for (std::int64_t i = 0; i < p.size(); ++i) {
+    const size_t s = static_cast<size_t>(i);
+    acceleration_[s] = (p.force_N[s] + external_force_[s]) / p.mass_g[s] + body_acceleration_;
+  }
+}
+
+double TissueDynamics::time_step_ms(double max_dt_ms) const {
+  const double stable_dt = tissue_.stable_time_step_ms();
+  const double first = steps_ == 0 ? stable_dt : first_dt_ms_;
+  if (!(stable_dt > 1e-4 * first) || !std::isfinite(stable_dt))
+    throw SolverError(fmt::format("the tissue's time step collapsed to {:.3g} ms (first step {:.3g} ms) at t = {:.6g} ms", stable_dt,
+                                  first, time_ms_));
+  return std::min(stable_dt, max_dt_ms);
+}
+
+double TissueDynamics::kick_and_drift(double max_dt_ms) {
+  NEEDLE_REQUIRE(!drifted_, "the tissue's step was not finished before the next");
+  TissueParticles& p = tissue_.particles();
+  const std::int64_t n = p.size();
+  if (steps_ == 0) first_dt_ms_ = tissue_.stable_time_step_ms();
+  const double dt = time_step_ms(max_dt_ms);
+  step_dt_ms_ = dt;
+
+  // Half kick, constraints, drift.
+  for (size_t k = 0; k < constrained_.size(); ++k) constrained_velocity_before_[k] = p.velocity_mm_per_ms[static_cast<size_t>(constrained_[k])];
+  std::vector<Vec3d>& v = p.velocity_mm_per_ms;
+  for (std::int64_t i = 0; i < n; ++i) v[static_cast<size_t>(i)] += (0.5 * dt) * acceleration_[static_cast<size_t>(i)];
+  apply_constraints(v, time_ms_ + 0.5 * dt, dt);
+  for (size_t k = 0; k < constrained_.size(); ++k) constrained_velocity_half_[k] = p.velocity_mm_per_ms[static_cast<size_t>(constrained_[k])];
+  old_force_ = p.force_N;
+  for (std::int64_t i = 0; i < n; ++i) old_force_[static_cast<size_t>(i)] += external_force_[static_cast<size_t>(i)];
+  parallel_for(n, [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t i = begin; i < end; ++i) {
+      displacement_[static_cast<size_t>(i)] = dt * p.velocity_mm_per_ms[static_cast<size_t>(i)];
+      p.position_mm[static_cast<size_t>(i)] += displacement_[static_cast<size_t>(i)];
+    }
+  });
+  time_ms_ += dt;
+  drifted_ = true;
+  return dt;
+}
+
+StepReport TissueDynamics::finish_step(const std::vector<Vec3d>* external_force_N) {
+  NEEDLE_REQUIRE(drifted_, "finish_step needs kick_and_drift first");
+  drifted_ = false;
+  TissueParticles& p = tissue_.particles();
+  const std::int64_t n = p.size();
+  const double dt = step_dt_ms_;
+  const std::vector<Vec3d>& old_force = old_force_;
+  const std::vector<Vec3d>& displacement = displacement_;
+  StepReport report;
+  report.dt_ms = dt;
+  const ForceReport forces = tissue_.compute_forces(dt);
+  report.bonds_broken_now = forces.bonds_broken_now;
+  report.rate_factor_capped = forces.rate_factor_capped;
+  report.particles_detached_now = forces.particles_detached_now;
+  if (external_force_N) {
+    NEEDLE_REQUIRE(external_force_N->size() == static_cast<size_t>(n), "external forces need one force per particle");
+    old_external_force_.swap(external_force_);
+    external_force_ = *external_force_N;
+  } else {
+    old_external_force_ = external_force_;
+  }
+  // old_force holds internal + external at the step's start; split the trapezoid sums accordingly.
+  double model_work = 0, body_work = 0, external_work = 0;
+  for (std::int64_t i = 0; i < n; ++i) {
+    const size_t s = static_cast<size_t>(i);
+    if (!p.force_N[s].allFinite() || !external_force_[s].allFinite())
+      throw SolverError(fmt::format("non-finite force on particle {} at t = {:.6g} ms", i, time_ms_));
+    const Vec3d old_internal = old_force[s] - old_external_force_[s];
+    model_work += 0.5 * (old_internal + p.force_N[s]).dot(displacement[s]);
+    external_work += 0.5 * (old_external_force_[s] + external_force_[s]).dot(displacement[s]);
+    body_work += p.mass_g[s] * body_acceleration_.dot(displacement[s]);
+    acceleration_[s] = (p.force_N[s] + external_force_[s]) / p.mass_g[s] + body_acceleration_;
+  }
+  energy_.model_work_mJ += model_work;
+  energy_.body_work_mJ += body_work;
+  energy_.external_work_mJ += external_work;
+  std::vector<Vec3d>& v = p.velocity_mm_per_ms;
+  for (std::int64_t i = 0; i < n; ++i) v[static_cast<size_t>(i)] += (0.5 * dt) * acceleration_[static_cast<size_t>(i)];
+  apply_constraints(v, time_ms_, 0.0);
+  // Reactions on constrained components: R = m dv/dt - f over the step, working through the displacement.
+  double constraint_work = 0;
+  for (size_t k = 0; k < constrained_.size(); ++k) {
+    const size_t s = static_cast<size_t>(constrained_[k]);
+    for (int axis = 0; axis < 3; ++axis) {
+      if (!(constrained_mask_[s] & (1 << axis))) continue;
+      constraint_work += p.mass_g[s] * (p.velocity_mm_per_ms[s][axis] - constrained_velocity_before_[k][axis]) *
+                             constrained_velocity_half_[k][axis] -
+                         0.5 * (old_force[s][axis] + p.force_N[s][axis] + external_force_[s][axis]) * displacement[s][axis];
+    }
+  }
+  energy_.constraint_work_mJ += constraint_work + impact_work_correction_mJ_;
+  impact_work_correction_mJ_ = 0;
+  landed_.clear();
+  energy_.kinetic_mJ = kinetic_energy_mJ();
+  if (!std::isfinite(energy_.kinetic_mJ)) throw SolverError(fmt::format("kinetic energy is not finite at t = {:.6g} ms", time_ms_));
+  tissue_.end_of_step();
+  ++steps_;
+  return report;
+}
+
+StepReport TissueDynamics::step(double max_dt_ms) {
+  kick_and_drift(max_dt_ms);
+  return finish_step(nullptr);
+}
+
+Eigen::Vector3d TissueDynamics::constraint_internal_force_N(size_t constraint) const {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (std::int32_t i : constraints_.at(constraint).particles) sum += tissue_.particles().force_N[static_cast<size_t>(i)];
+  return sum;
+}
+
+}  // namespace needle

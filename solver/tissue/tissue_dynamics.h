@@ -1,0 +1,104 @@
+#pragma once
+// Explicit central-difference time integration (velocity Verlet form, so velocities are known at full
+// steps for the energy balance) of the SPG tissue with boundary conditions and body loads:
+//   v(n+1/2) = v(n) + dt/2 a(n);  constraints;  x(n+1) = x(n) + dt v(n+1/2);
+//   forces at x(n+1);  v(n+1) = v(n+1/2) + dt/2 a(n+1);  constraints.
+// Fixed particles (ParticleFlag) have v = 0, symmetry particles v_z = 0 (opened ones z >= 0: a step's
+// drift stops on the plane, symmetry_slit.h); velocity constraints prescribe
+// one component on a set of particles. Energy balance: kinetic - kinetic(0) = work of the model's forces
+// + work of body loads + work of the reactions (on constrained components: m dv/dt - f, times the
+// displacement); its relative error is the drift of the integrator.
+#include <Eigen/Dense>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <vector>
+
+#include "solver/tissue/spg_tissue.h"
+
+namespace needle {
+
+struct VelocityConstraint {
+  std::vector<std::int32_t> particles;
+  int axis = 0;                                              // 0 x, 1 y, 2 z
+  std::function<double(double time_ms)> velocity_mm_per_ms;  // prescribed velocity component
+  std::vector<double> scale;  // optional, one per particle: its velocity is scale x the function
+};
+
+struct EnergyBalance {
+  double kinetic_mJ = 0;
+  double model_work_mJ = 0;        // work of internal and stabilization forces (= - stored and dissipated energy)
+  double body_work_mJ = 0;
+  double external_work_mJ = 0;     // work of external forces (contact with the needle)
+  double constraint_work_mJ = 0;
+  double initial_kinetic_mJ = 0;
+  // |KE - KE0 - W_model - W_body - W_external - W_constraint| / max(|terms|): the integrator's drift
+  double relative_error() const;
+};
+
+struct StepReport {
+  double dt_ms = 0;
+  std::int64_t bonds_broken_now = 0;
+  std::int64_t rate_factor_capped = 0;
+  std::int64_t particles_detached_now = 0;
+};
+
+class TissueDynamics {
+ public:
+  TissueDynamics(SpgTissue& tissue, std::vector<VelocityConstraint> constraints,
+                 const Eigen::Vector3d& body_acceleration_mm_per_ms2 = Eigen::Vector3d::Zero());
+
+  // External forces (the contact), one per particle, at the current state: they join the accelerations
+  // that start the next step (call before the first step; finish_step takes each step's end values). They
+  // act like internal forces in the step, and their work is booked apart.
+  void set_external_forces(const std::vector<Vec3d>& force_N);
+
+  // The step the next step will take: the tissue's stable step capped at max_dt_ms.
+  double time_step_ms(double max_dt_ms = std::numeric_limits<double>::infinity()) const;
+  // One step in two halves, so that another body can move between them (the coupled insertion):
+  //   kick_and_drift: v(n+1/2) = v(n) + dt/2 a(n), constraints, x(n+1) = x(n) + dt v(n+1/2), t += dt;
+  //     dt is the tissue's stable step capped at max_dt_ms (> 0); returns it. SolverError on a collapsed
+  //     time step (below 1e-4 of the first).
+  //   finish_step: forces at x(n+1) with the external forces given (nullptr: the last ones, unchanged),
+  //     the work of each force, v(n+1) = v(n+1/2) + dt/2 a(n+1), constraints and their work. SolverError
+  //     on non-finite forces or energy.
+  double kick_and_drift(double max_dt_ms = std::numeric_limits<double>::infinity());
+  StepReport finish_step(const std::vector<Vec3d>* external_force_N = nullptr);
+  // Both halves with the external forces held.
+  StepReport step(double max_dt_ms = std::numeric_limits<double>::infinity());
+
+  double time_ms() const { return time_ms_; }
+  std::int64_t steps() const { return steps_; }
+  const EnergyBalance& energy() const { return energy_; }
+  const std::vector<Vec3d>& external_forces() const { return external_force_; }
+  // Sum over a constraint's particles of the force the tissue exerts on them (N): minus the reaction.
+  Eigen::Vector3d constraint_internal_force_N(size_t constraint) const;
+
+ private:
+  // drift_dt_ms > 0 before a drift of that length: an open symmetry particle's v_z is then kept from
+  // carrying it below z = 0 (it lands on the plane); 0 after the drift.
+  void apply_constraints(std::vector<Vec3d>& v, double time_ms, double drift_dt_ms);
+  double kinetic_energy_mJ() const;
+
+  SpgTissue& tissue_;
+  std::vector<VelocityConstraint> constraints_;
+  Eigen::Vector3d body_acceleration_;
+  double time_ms_ = 0, first_dt_ms_ = 0, step_dt_ms_ = 0;
+  bool drifted_ = false;  // between kick_and_drift and finish_step
+  std::int64_t steps_ = 0;
+  EnergyBalance energy_;
+  std::vector<Vec3d> acceleration_;
+  double impact_work_correction_mJ_ = 0;        // this step's: open symmetry particles stopped on the plane
+  struct Landing {
+    std::int32_t particle;
+    double v_half_z;
+  };
+  std::vector<Landing> landed_;                 // this step's impacts on the plane
+  std::vector<std::int32_t> constrained_;      // particles with a constrained component
+  std::vector<std::uint8_t> constrained_mask_;  // per particle: bit k = component k constrained
+  // Step scratch, kept to avoid allocating per step.
+  std::vector<Vec3d> old_force_, displacement_, constrained_velocity_before_, constrained_velocity_half_;
+  std::vector<Vec3d> external_force_, old_external_force_;
+};
+
+}  // namespace needle
