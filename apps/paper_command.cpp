@@ -163,7 +163,7 @@ void add_paper_command(CLI::App& app) {
   c->add_option("--replica", o->replicas,
                 "LABEL=FILE: the results.json of a report of this same model whose runs differ only in a numerical detail, e.g. "
                 "--tissue-entry-x-mm 0.1 (the lattice shifted against the path); the report gives each deflection's spread over "
-                "the replicas and which targets hold in every one (scripts/scatter_study.sh); repeatable");
+                "the replicas and which targets hold in every one (docs/notebook/scripts/scatter_study.sh); repeatable");
   c->add_option("--label", o->label, "This report's name in the table of --compare (default 'this report')");
   c->add_flag("--report-only", o->report_only, "Only rewrite the report from the run folders already in OUT/runs");
   c->add_flag("--rerun", o->rerun, "Run every needle again even if OUT/runs holds a run of the same scene");

@@ -27,19 +27,19 @@ done
 # The paper reproduced: SB, LMB, AMB and HMB on the paper's scene with the tissue E calibrated on SB
 # (data/paper/calibration_sb.json, made by `needle calibrate`; docs/paper.md), about 20–40 minutes a needle
 # on 2 cores. A run the solver stops is reported as such in the report, not an error of the main job.
-# The report sets five other models beside it, from their stored reports in docs/paper_results/: the
+# The report sets five other models beside it, from their stored reports in docs/notebook/paper_results/: the
 # contact's former default (skin 0.04 mm, factor 10), skin 0.02 mm at factor 10, the groove 5 mm behind
 # the tip point, the tissue law that stiffens as the paper's measured curve, and no cut (docs/paper.md). Two replicas
 # of the default model, its runs repeated with the particle lattice shifted 0.1 and 0.05 mm against the needle's path
-# (scripts/scatter_study.sh), give each deflection's run-to-run scatter and the targets that hold in every replica.
+# (docs/notebook/scripts/scatter_study.sh), give each deflection's run-to-run scatter and the targets that hold in every replica.
 ./build/apps/needle paper --calibration data/paper/calibration_sb.json --out out/paper --label "cut, 0.2 mm near the path, skin 0.02 mm" \
-  --compare "skin 0.04 mm, factor 10 (the default before), E 0.0748=docs/paper_results/skin0.04_k10/results.json" \
-  --compare "skin 0.02 mm, factor 10, calibrated (E 0.080)=docs/paper_results/skin0.02_calibrated/results.json" \
-  --compare "groove 5 mm behind A, skin 0.04 mm, calibrated (E 0.0493)=docs/paper_results/groove5_calibrated/results.json" \
-  --compare "stiffening law, skin 0.04 mm, calibrated on SB=docs/paper_results/stiffening_calibrated/results.json" \
-  --compare "no cut, skin 0.04 mm, E 0.0748=docs/paper_results/no_cut/results.json" \
-  --replica "lattice +0.1 mm=docs/paper_results/lattice_shift_0.1mm/results.json" \
-  --replica "lattice +0.05 mm=docs/paper_results/lattice_shift_0.05mm/results.json"
+  --compare "skin 0.04 mm, factor 10 (the default before), E 0.0748=docs/notebook/paper_results/skin0.04_k10/results.json" \
+  --compare "skin 0.02 mm, factor 10, calibrated (E 0.080)=docs/notebook/paper_results/skin0.02_calibrated/results.json" \
+  --compare "groove 5 mm behind A, skin 0.04 mm, calibrated (E 0.0493)=docs/notebook/paper_results/groove5_calibrated/results.json" \
+  --compare "stiffening law, skin 0.04 mm, calibrated on SB=docs/notebook/paper_results/stiffening_calibrated/results.json" \
+  --compare "no cut, skin 0.04 mm, E 0.0748=docs/notebook/paper_results/no_cut/results.json" \
+  --replica "lattice +0.1 mm=docs/notebook/paper_results/lattice_shift_0.1mm/results.json" \
+  --replica "lattice +0.05 mm=docs/notebook/paper_results/lattice_shift_0.05mm/results.json"
 echo "results in out/: <preset>.json (report), <preset>.stl, <preset>_half.glb, <preset>.png,"
 echo "  <preset>_half_t10.msh/.vtu + <preset>_mesh.json (T10 mesh and its report), tissue_particles.vtp/.json,"
 echo "  material_test.csv/.png/.json (the tissue card in uniaxial tension), stiffness_<preset>.json (tip compliance"

@@ -61,7 +61,7 @@ namespace needle {
 struct ContactOptions {
   double friction = 0.18;         // Coulomb coefficient needle-tissue (paper)
   double stiffness_factor = 30.0; // penalty stiffness over the particle's own (see above); at 30 it lets no particle
-                                  // deeper than 0.023 mm inside the needle over the paper's 30 mm (10: 0.07 mm; docs/paper.md)
+                                  // deeper than 0.023 mm inside the needle over the paper's 30 mm (10: 0.07 mm; docs/notebook/paper_studies.md)
   double skin_mm = 0.02;          // contact starts this far outside the surface (0.04 until the skin study showed AMB's
                                   // deflection converging only below 0.02 mm)
   double damping_ratio = 0.2;     // normal viscous damping, fraction of critical 2 sqrt(k m_r) (LS-DYNA's VDC)

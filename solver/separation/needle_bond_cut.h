@@ -6,7 +6,7 @@
 // through a body that separates them. An SPG support (1.8 spacings) is wider than the gap the needle opens
 // (2.5 spacings wide at the paper's 0.4 mm particles), so without it the tissue above and below the needle
 // stays bonded through the steel: the tissue is pushed aside and closes around the needle like a stretched
-// band instead of being cut at the tip (docs/paper.md measures both).
+// band instead of being cut at the tip (docs/notebook/paper_studies.md measures both).
 //
 // A segment passes through the needle when it meets the needle's current surface at two distinct points
 // (it enters and leaves). A particle that has sunk inside the needle, and so meets the surface once,

@@ -5,7 +5,7 @@
 // The needle's cut (needle_bond_cut.h) separates the tissue along the needle's own surface: in the
 // symmetry plane that surface's normals lie in the plane, so every particle on the plane that the tip
 // reaches is pushed up or down, and the tissue below a tip point above the rod's bottom stays pressed
-// down under the whole shaft (docs/paper.md). A real tip's cutting edges can instead split the gel
+// down under the whole shaft (docs/notebook/paper_studies.md). A real tip's cutting edges can instead split the gel
 // in the plane, as a knife does. In a half model that split is the symmetry particles leaving the
 // plane: their mirror images move the other way, and the plane is where the two faces meet, so an
 // opened particle keeps only z >= 0 (kParticleOpenSymmetry, explicit_dynamics.h).

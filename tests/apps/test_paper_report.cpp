@@ -388,7 +388,7 @@ TEST_CASE("needle paper says why a deflection target is missed: margin against s
 }
 
 TEST_CASE("needle paper names its own runs/NAME folder even where it is a link to a run made elsewhere", "[apps][paper]") {
-  // scripts/scatter_study.sh links each needle's run into one report folder; the report must not name the link's
+  // docs/notebook/scripts/scatter_study.sh links each needle's run into one report folder; the report must not name the link's
   // target, which a copy of the report folder does not carry.
   const fs::path dir = fresh("linked"), elsewhere = fresh("linked_target");
   write_run(elsewhere, "SB", {-1.10, 0.90});

@@ -305,8 +305,8 @@ TEST_CASE("A needle turned upside down deflects the other way by as much: the co
   // What may break it: the two gmsh meshes are not mirror images of each other, and the needle's cut
   // and the contact see the particles in a different order. A bias in the contact, the cut or the
   // tissue (a sign convention, a y-only tie-break) would show as a sum far from 0. The paper's
-  // multi-bevel needles deflect too far up (docs/paper.md); this measures the model's own share of
-  // that, here and at 10 mm on the paper scene (scripts/symmetry_probe.sh: -0.157 / +0.151 mm).
+  // multi-bevel needles deflect too far up (docs/notebook/paper_studies.md); this measures the model's own share of
+  // that, here and at 10 mm on the paper scene (docs/notebook/scripts/symmetry_probe.sh: -0.157 / +0.151 mm).
   GrindingRecipe down = preset_recipe("SB");
   down.groove.reset();
   down.rod.length_mm = 16.0;
