@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "apps/json_file.h"
+#include "apps/run_driver.h"
 #include "apps/run_folder.h"
 #include "apps/scene_needle.h"
 #include "core/input_error.h"
@@ -191,145 +192,125 @@ Scene default_run_scene() {
   return s;
 }
 
+namespace {
+
+// The coupled insertion of a scene as the run driver runs it (run_driver.h).
+class InsertionRunModel : public RunModel {
+ public:
+  explicit InsertionRunModel(const Scene& scene) : scene_(scene) {
+    NEEDLE_REQUIRE(scene.tissue.enabled, "run_insertion needs a scene with tissue.enabled");
+    const auto start = Clock::now();
+    built_ = build_scene_needle(scene.needle);
+    rigid_ = scene.needle.model == "rigid";  // no mass scaling: a rigid needle takes any step
+    needle_ = std::make_unique<FeNeedle>(built_.mesh, scene.needle.material, rigid_ ? 0.0 : scene.solver.mass_scaling_dt_ms);
+    ContactSurfaceOptions surface_options;
+    surface_options.voxel_mm = scene.tissue.contact.voxel_mm;
+    surface_ = std::make_unique<ContactSurface>(needle_->mesh(), surface_options);
+    particles_ = scene_particles(scene);
+    tissue_ = std::make_unique<SpgTissue>(particles_, scene.tissue.material, scene.tissue.spg);
+    ContactOptions contact = scene.tissue.contact;
+    contact.cutting_facets = built_.tip_facets;
+    const bool ground_tip = !built_.tip_facets.empty();  // a plain rod's end is cut square; a mesh file names no facets
+    NEEDLE_REQUIRE(contact.cutting_pressure_MPa == 0 || ground_tip,
+                   "a cutting pressure needs a needle with tip facets: a ground tip from a preset, d_a or a recipe (not a plain rod or a mesh file)");
+    NEEDLE_REQUIRE(!scene.tissue.separation.crack.enabled() || ground_tip,
+                   "a crack from the tip point needs a needle with a ground tip point: a preset, d_a or a recipe (not a plain rod or a mesh file)");
+    std::vector<std::unique_ptr<SeparationModel>> separations = make_separation_models(scene.tissue.separation, *surface_);
+    setup_s_ = std::chrono::duration<double>(Clock::now() - start).count();
+    needle_model_ = make_needle_model(scene.needle.model, {*needle_, driven_base_supports(needle_->mesh(), scene.motion, scene.direction),
+                                                           scene.cannula.enabled ? std::optional<CannulaOptions>(scene.cannula) : std::nullopt,
+                                                           scene_dynamics_options(scene)});
+    run_ = std::make_unique<CoupledInsertion>(*needle_model_, *tissue_, *surface_, contact, std::move(separations), scene.solver.coupling);
+    tip_ = nearest_node(needle_->mesh(), built_.tip_point);
+  }
+
+  std::string needle_name() const override { return built_.name; }
+  std::vector<std::string> setup_log() const override {
+    const FeNeedle& n = *needle_;
+    const ContactSurface& surface = *surface_;
+    return {fmt::format("needle {}: {} T{} elements, {} nodes, meshed in {:.2f} s{}", built_.name, built_.mesh.num_tets(),
+                        built_.mesh.order == 2 ? 10 : 4, built_.mesh.num_nodes(), built_.mesh_seconds, rigid_ ? " (rigid)" : ""),
+            fmt::format("needle stable step {:.4g} ms (unscaled {:.4g} ms); added mass {:.3g} % in {} elements", n.stable_time_step_ms(),
+                        n.unscaled_time_step_ms(), 100 * n.added_mass_g() / n.physical_mass_g(), n.mass_scaled_elements()),
+            fmt::format("contact surface: {} triangles, level set {} voxels of {} mm ({:.1f} MiB) built in {:.2f} s", surface.num_triangles(),
+                        surface.level_set().active_voxels(), surface.level_set().voxel_mm(), surface.level_set().memory_bytes() / 1048576.0,
+                        surface.level_set().build_seconds()),
+            fmt::format("tissue: {} particles at {:.3g} mm ({:.3g} mm near the path), {} bonds; set-up {:.2f} s", particles_.num_particles(),
+                        scene_.tissue.spacing_mm, particles_.spacing_mm.minCoeff(), tissue_->bonds().bonds.size(), setup_s_),
+            fmt::format("run to {:.6g} ms: needle step {:.4g} ms, first coupling step {:.4g} ms (tissue {:.4g}, contact {:.4g})", end_time_ms(),
+                        needle_model_->time_step_ms(), run_->tissue_dynamics().time_step_ms(), tissue_->stable_time_step_ms(),
+                        scene_.solver.coupling.contact_courant * run_->contact_model().stable_time_step_ms())};
+  }
+  double end_time_ms() const override { return scene_.motion.end_time_ms(); }
+  double time_ms() const override { return run_->time_ms(); }
+  long steps() const override { return run_->steps(); }
+  void step(double end_time_ms) override { run_->step(end_time_ms); }
+  void open_outputs(const RunFolder& folder) override { output_ = std::make_unique<InsertionOutput>(folder, *surface_, run_->separations()); }
+  void record() override { output_->record(*run_, tip_, run_groove_fill(*run_, built_, scene_)); }
+  void frame(const RunFolder&) override { output_->frame(*run_); }
+  void close_outputs(const RunFolder&) override { output_->finish(); }
+  Eigen::Vector3d tip_displacement_mm() const override {
+    return (needle_model_->positions_mm().row(tip_) - needle_->mesh().X.row(tip_)).transpose();
+  }
+  Eigen::Vector3d drive_displacement_mm() const override { return needle_model_->drive_displacement_mm(); }
+  double energy_balance_error() const override { return run_->energy().balance_error(); }
+  double max_energy_balance_error() const override { return run_->max_energy_error(); }
+
+  void add_summary(json& summary, double) const override {
+    const InsertionEnergy& e = run_->energy();
+    const GrooveFill groove = run_groove_fill(*run_, built_, scene_);
+    summary["needle_steps"] = run_->needle_steps();
+    summary["needle_model"] = needle_model_->name();
+    summary["subcycling"] = scene_.solver.coupling.subcycling;
+    summary["energy_mJ"] = {{"drive_work", e.drive_work_mJ}, {"tissue_internal", e.tissue_internal_mJ}, {"tissue_kinetic", e.tissue_kinetic_mJ},
+                            {"needle_kinetic", e.needle_kinetic_mJ}, {"needle_strain", e.needle_strain_mJ}, {"contact_work", e.contact_work_mJ},
+                            {"penalty", e.penalty_energy_mJ}, {"friction_dissipation", e.friction_dissipation_mJ}, {"cannula_work", e.cannula_work_mJ}};
+    summary["max_penetration_mm"] = run_->max_depth_mm();
+    summary["particles_inside"] = run_->contact().particles_inside;
+    summary["max_particles_inside"] = run_->max_particles_inside();
+    summary["particles"] = particles_.num_particles();
+    summary["bonds_broken"] = run_->bonds_broken();
+    summary["cutting"] = {{"pressure_MPa", scene_.tissue.contact.cutting_pressure_MPa}, {"work_mJ", run_->contact_model().cutting_work_mJ()},
+                          {"force_at_end_N", run_->contact().cutting_force_N}};
+    summary["groove"] = {{"groove_fill", groove.groove_fill},
+                         {"floor_contact_fraction", groove.floor_contact_fraction},
+                         {"mean_gap_mm", groove.mean_gap_mm},
+                         {"length_in_tissue_mm", groove.length_in_tissue_mm},
+                         {"particles_in_groove", groove.particles_in_groove},
+                         {"definition", "docs/insertion.md#groove-fill: mean over the groove's length in tissue of the filled share of its depth "
+                                        "(tissue's lowest edge to the rod's top over floor to top), in the needle's own frame"}};
+    summary["mesh"] = {{"order", needle_->mesh().order}, {"elements", needle_->num_elements()}, {"nodes", needle_->num_nodes()}};
+    needle_model_->add_summary(summary);
+    for (const auto& separation : run_->separations()) separation->add_summary(summary, run_->tissue());
+  }
+  std::string log_steps(double solve_s) const override {
+    return fmt::format("{} coupling steps and {} needle steps in {:.2f} s, energy balance error {:.3g}, max penetration {:.3g} mm, {} particles "
+                       "inside at the end",
+                       run_->steps(), run_->needle_steps(), solve_s, run_->energy().balance_error(), run_->max_depth_mm(),
+                       run_->contact().particles_inside);
+  }
+  std::string print_steps() const override { return fmt::format("{} steps ({} needle steps)", run_->steps(), run_->needle_steps()); }
+
+ private:
+  const Scene& scene_;
+  SceneNeedle built_;
+  bool rigid_ = false;
+  std::unique_ptr<FeNeedle> needle_;
+  std::unique_ptr<ContactSurface> surface_;
+  ParticleSet particles_;
+  std::unique_ptr<SpgTissue> tissue_;
+  std::unique_ptr<NeedleModel> needle_model_;
+  std::unique_ptr<CoupledInsertion> run_;
+  int tip_ = 0;
+  double setup_s_ = 0;
+  std::unique_ptr<InsertionOutput> output_;
+};
+
+}  // namespace
+
 void run_insertion(const Scene& scene, const RunOptions& o) {
-  NEEDLE_REQUIRE(scene.tissue.enabled, "run_insertion needs a scene with tissue.enabled");
-  const ThreadLimit threads(o.threads >= 0 ? o.threads : scene.solver.threads);
-  // Everything that can be wrong with the input is found before the run folder exists.
-  const auto start = Clock::now();
-  const SceneNeedle built = build_scene_needle(scene.needle);
-  const bool rigid = scene.needle.model == "rigid";  // no mass scaling: a rigid needle takes any step
-  const FeNeedle needle(built.mesh, scene.needle.material, rigid ? 0.0 : scene.solver.mass_scaling_dt_ms);
-  ContactSurfaceOptions surface_options;
-  surface_options.voxel_mm = scene.tissue.contact.voxel_mm;
-  const ContactSurface surface(needle.mesh(), surface_options);
-  const ParticleSet particles = scene_particles(scene);
-  SpgTissue tissue(particles, scene.tissue.material, scene.tissue.spg);
-  ContactOptions contact = scene.tissue.contact;
-  contact.cutting_facets = built.tip_facets;
-  const bool ground_tip = !built.tip_facets.empty();  // a plain rod's end is cut square; a mesh file names no facets
-  NEEDLE_REQUIRE(contact.cutting_pressure_MPa == 0 || ground_tip,
-                 "a cutting pressure needs a needle with tip facets: a ground tip from a preset, d_a or a recipe (not a plain rod or a mesh file)");
-  NEEDLE_REQUIRE(!scene.tissue.separation.crack.enabled() || ground_tip,
-                 "a crack from the tip point needs a needle with a ground tip point: a preset, d_a or a recipe (not a plain rod or a mesh file)");
-  std::vector<std::unique_ptr<SeparationModel>> separations = make_separation_models(scene.tissue.separation, surface);
-  const double setup_s = std::chrono::duration<double>(Clock::now() - start).count();
-
-  RunFolder folder(o.out_dir, o.overwrite);
-  std::filesystem::create_directories(folder.path("frames"));
-  RunLog log(folder.path("run.log"));
-  {
-    std::ofstream effective(folder.path("scene.json"));
-    effective << scene_to_json(scene).dump(2) << "\n";
-  }
-  log.line(fmt::format("scene {}", scene.source));
-  log.line(fmt::format("needle {}: {} T{} elements, {} nodes, meshed in {:.2f} s{}", built.name, built.mesh.num_tets(),
-                       built.mesh.order == 2 ? 10 : 4, built.mesh.num_nodes(), built.mesh_seconds, rigid ? " (rigid)" : ""));
-  log.line(fmt::format("needle stable step {:.4g} ms (unscaled {:.4g} ms); added mass {:.3g} % in {} elements", needle.stable_time_step_ms(),
-                       needle.unscaled_time_step_ms(), 100 * needle.added_mass_g() / needle.physical_mass_g(), needle.mass_scaled_elements()));
-  log.line(fmt::format("contact surface: {} triangles, level set {} voxels of {} mm ({:.1f} MiB) built in {:.2f} s", surface.num_triangles(),
-                       surface.level_set().active_voxels(), surface.level_set().voxel_mm(), surface.level_set().memory_bytes() / 1048576.0,
-                       surface.level_set().build_seconds()));
-  log.line(fmt::format("tissue: {} particles at {:.3g} mm ({:.3g} mm near the path), {} bonds; set-up {:.2f} s", particles.num_particles(),
-                       scene.tissue.spacing_mm, particles.spacing_mm.minCoeff(), tissue.bonds().bonds.size(), setup_s));
-
-  const std::unique_ptr<NeedleModel> needle_model = make_needle_model(
-      scene.needle.model, {needle, driven_base_supports(needle.mesh(), scene.motion, scene.direction),
-                           scene.cannula.enabled ? std::optional<CannulaOptions>(scene.cannula) : std::nullopt, scene_dynamics_options(scene)});
-  const NeedleModel& needle_run = *needle_model;
-  CoupledInsertion run(*needle_model, tissue, surface, contact, std::move(separations), scene.solver.coupling);
-  const int tip = nearest_node(needle.mesh(), built.tip_point);
-  const double end_ms = scene.motion.end_time_ms();
-  log.line(fmt::format("run to {:.6g} ms: needle step {:.4g} ms, first coupling step {:.4g} ms (tissue {:.4g}, contact {:.4g})", end_ms,
-                       needle_run.time_step_ms(), run.tissue_dynamics().time_step_ms(), tissue.stable_time_step_ms(),
-                       scene.solver.coupling.contact_courant * run.contact_model().stable_time_step_ms()));
-
-  InsertionOutput output(folder, surface, run.separations());
-  output.record(run, tip, run_groove_fill(run, built, scene));
-  if (scene.output.frames > 0) output.frame(run);
-  ProgressBar progress(end_ms, o.quiet);
-  std::string status = "finished", reason;
-  double next_history = scene.output.history_interval_ms;
-  int next_frame = 1;
-  const auto solve_start = Clock::now();
-  try {
-    while (run.time_ms() < end_ms - 1e-12) {
-      run.step(end_ms);
-      if (run.time_ms() >= next_history - 1e-12 || run.time_ms() >= end_ms - 1e-12) {
-        output.record(run, tip, run_groove_fill(run, built, scene));
-        next_history += scene.output.history_interval_ms;
-      }
-      if (scene.output.frames > 0 && run.time_ms() >= next_frame * end_ms / scene.output.frames - 1e-12) {
-        output.frame(run);
-        ++next_frame;
-      }
-      progress.update(run.time_ms(), run.steps(), "ms");
-    }
-  } catch (const SolverError& e) {
-    status = "stopped";
-    reason = e.what();
-    output.record(run, tip, run_groove_fill(run, built, scene));
-  }
-  progress.finish();
-  const double solve_s = std::chrono::duration<double>(Clock::now() - solve_start).count();
-  output.finish();
-
-  const Eigen::RowVector3d u = needle_run.positions_mm().row(tip) - needle.mesh().X.row(tip);
-  const double deflection = u.y() - needle_run.drive_displacement_mm().y();
-  const InsertionEnergy& e = run.energy();
-  const GrooveFill groove = run_groove_fill(run, built, scene);
-  json summary = {
-      {"status", status},
-      {"reason", reason},
-      {"needle", built.name},
-      {"deflection_mm", deflection},
-      {"tip_displacement_mm", {u.x(), u.y(), u.z()}},
-      {"insertion_mm", needle_run.drive_displacement_mm().norm()},
-      {"time_ms", run.time_ms()},
-      {"steps", run.steps()},
-      {"needle_steps", run.needle_steps()},
-      {"subcycling", scene.solver.coupling.subcycling},
-      {"energy_balance_error", e.balance_error()},
-      {"max_energy_balance_error", run.max_energy_error()},
-      {"energy_mJ", {{"drive_work", e.drive_work_mJ}, {"tissue_internal", e.tissue_internal_mJ}, {"tissue_kinetic", e.tissue_kinetic_mJ},
-                     {"needle_kinetic", e.needle_kinetic_mJ}, {"needle_strain", e.needle_strain_mJ}, {"contact_work", e.contact_work_mJ},
-                     {"penalty", e.penalty_energy_mJ}, {"friction_dissipation", e.friction_dissipation_mJ}, {"cannula_work", e.cannula_work_mJ}}},
-      {"max_penetration_mm", run.max_depth_mm()},
-      {"particles_inside", run.contact().particles_inside},
-      {"max_particles_inside", run.max_particles_inside()},
-      {"particles", particles.num_particles()},
-      {"bonds_broken", run.bonds_broken()},
-      {"needle_model", needle_run.name()},
-      {"cutting", {{"pressure_MPa", scene.tissue.contact.cutting_pressure_MPa}, {"work_mJ", run.contact_model().cutting_work_mJ()},
-                   {"force_at_end_N", run.contact().cutting_force_N}}},
-      {"groove",
-       {{"groove_fill", groove.groove_fill},
-        {"floor_contact_fraction", groove.floor_contact_fraction},
-        {"mean_gap_mm", groove.mean_gap_mm},
-        {"length_in_tissue_mm", groove.length_in_tissue_mm},
-        {"particles_in_groove", groove.particles_in_groove},
-        {"definition", "docs/insertion.md#groove-fill: mean over the groove's length in tissue of the filled share of its depth "
-                       "(tissue's lowest edge to the rod's top over floor to top), in the needle's own frame"}}},
-      {"runtime_s", std::chrono::duration<double>(Clock::now() - start).count()},
-      {"solve_s", solve_s},
-      {"peak_memory_MiB", peak_memory_MiB()},
-      {"mesh", {{"order", needle.mesh().order}, {"elements", needle.num_elements()}, {"nodes", needle.num_nodes()}}},
-      {"threads", hardware_threads()},
-  };
-  needle_run.add_summary(summary);
-  for (const auto& separation : run.separations()) separation->add_summary(summary, run.tissue());
-  {
-    std::ofstream out(folder.path("summary.json"));
-    out << summary.dump(2) << "\n";
-  }
-  log.line(fmt::format("{}{}: deflection {:.6g} mm after {} coupling steps and {} needle steps in {:.2f} s, energy balance error {:.3g}, "
-                       "max penetration {:.3g} mm, {} particles inside at the end",
-                       status, reason.empty() ? "" : " (" + reason + ")", deflection, run.steps(), run.needle_steps(), solve_s,
-                       e.balance_error(), run.max_depth_mm(), run.contact().particles_inside));
-  folder.commit();
-  if (!o.quiet)
-    fmt::print("{} {}: deflection {:.6g} mm, {} steps ({} needle steps), {:.1f} s -> {}\n", built.name, status, deflection, run.steps(),
-               run.needle_steps(), solve_s, folder.final_path().string());
-  if (status != "finished" && o.throw_on_stop) throw SolverError(reason + fmt::format(" (what was written so far is in {})", o.out_dir));
+  // Everything that can be wrong with the input is found while the model is built, before the run folder exists.
+  drive_run(scene, o, [&scene] { return std::make_unique<InsertionRunModel>(scene); });
 }
 
 bool folder_holds_run_of(const Scene& scene, const std::string& folder_name) {

@@ -4,16 +4,11 @@
 // tissue.pvd with frames/, run.log. Used by `needle simulate` and `needle run`.
 #include <string>
 
+#include "apps/run_driver.h"
 #include "apps/scene.h"
 
 namespace needle {
 
-struct RunOptions {
-  std::string out_dir;
-  bool overwrite = false, quiet = false;
-  bool throw_on_stop = true;  // false: a run the solver stopped returns normally (its summary says so)
-  int threads = -1;           // -1: the scene's solver.threads
-};
 
 // The run defaults of `needle run` and `needle paper`: the paper's scene with tissue, and the needle
 // fidelity that keeps a 30 mm run within minutes (docs/insertion.md measures its error). The tissue's E is

@@ -39,10 +39,6 @@ void run(const RunCommandOptions& o) {
     n.mesh_file.clear();
     n.plain_rod = false;
   }
-  apply_scene_overrides(scene, o.overrides);
-  NEEDLE_REQUIRE(std::isnan(o.mass_scaling_dt_ms) || (std::isfinite(o.mass_scaling_dt_ms) && o.mass_scaling_dt_ms >= 0),
-                 "--mass-scaling-dt-ms must be zero (off) or positive");
-  if (!std::isnan(o.mass_scaling_dt_ms)) scene.solver.mass_scaling_dt_ms = o.mass_scaling_dt_ms;
   // The tissue's E: given, from a calibration, from the scene file, or (the run defaults) the SB calibration shipped
   // with the toolkit, so that the first run a user makes is the calibrated paper scene.
   NEEDLE_REQUIRE(std::isnan(o.tissue_E_MPa) || o.calibration_file.empty(), "give --tissue-E-MPa or --calibration, not both");
@@ -57,11 +53,19 @@ void run(const RunCommandOptions& o) {
     E_source = fmt::format("calibrated on SB: {}", file);
   }
   scene.tissue.material.validate();
+  NEEDLE_REQUIRE(std::isnan(o.mass_scaling_dt_ms) || (std::isfinite(o.mass_scaling_dt_ms) && o.mass_scaling_dt_ms >= 0),
+                 "--mass-scaling-dt-ms must be zero (off) or positive");
+  if (!std::isnan(o.mass_scaling_dt_ms)) scene.solver.mass_scaling_dt_ms = o.mass_scaling_dt_ms;
   if (o.frames >= 0) scene.output.frames = o.frames;
   if (o.no_subcycling) scene.solver.coupling.subcycling = false;
   if (o.rigid) scene.needle.model = "rigid";
-  if (!o.run.quiet) fmt::print("tissue E {:g} MPa, {}\n", scene.tissue.material.E_MPa, E_source);
-  run_insertion(scene, o.run);
+  // The scene flags and --set come last: a --set tissue.material.E_MPa is the E the run takes.
+  const double E_before = scene.tissue.material.E_MPa;
+  apply_scene_overrides(scene, o.overrides);
+  if (scene.tissue.material.E_MPa != E_before) E_source = "given with --set";
+  RunOptions run = o.run;
+  run.note = fmt::format("tissue E {:g} MPa, {}", scene.tissue.material.E_MPa, E_source);
+  run_insertion(scene, run);
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include "apps/scene.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <fmt/format.h>
 
@@ -268,6 +269,59 @@ json scene_to_json(const Scene& s) {
                   {"max_contact_depth_mm", s.solver.coupling.max_depth_mm}}},
       {"output", {{"history_interval_ms", s.output.history_interval_ms}, {"frames", s.output.frames}}},
   };
+}
+
+}  // namespace needle
+
+namespace needle {
+
+Scene apply_scene_settings(const Scene& scene, const std::vector<std::string>& settings) {
+  if (settings.empty()) return scene;
+  json j = scene_to_json(scene);
+  std::string given;
+  for (const std::string& setting : settings) {
+    given += (given.empty() ? "" : " ") + setting;
+    const size_t eq = setting.find('=');
+    NEEDLE_REQUIRE(eq != std::string::npos && eq > 0, fmt::format("--set {}: give key=value, e.g. --set tissue.material.E_MPa=0.1", setting));
+    const std::string key = setting.substr(0, eq), value = setting.substr(eq + 1);
+    std::vector<std::string> path;
+    for (size_t start = 0;;) {
+      const size_t dot = key.find('.', start);
+      path.push_back(key.substr(start, dot == std::string::npos ? std::string::npos : dot - start));
+      NEEDLE_REQUIRE(!path.back().empty(), fmt::format("--set {}: '{}' is not a dotted scene key (docs/scenes.md)", setting, key));
+      if (dot == std::string::npos) break;
+      start = dot + 1;
+    }
+    json* section = &j;
+    for (size_t k = 0; k + 1 < path.size(); ++k) {
+      json& next = (*section)[path[k]];
+      if (next.is_null()) next = json::object();
+      NEEDLE_REQUIRE(next.is_object(), fmt::format("--set {}: {} is a value, not a section", setting, path[k]));
+      section = &next;
+    }
+    const std::string& leaf = path.back();
+    static const std::vector<std::string> sources = {"preset", "d_a_mm", "d_a", "recipe", "mesh_file", "plain_rod"};
+    const bool is_source = path.size() == 2 && path[0] == "needle" && std::find(sources.begin(), sources.end(), leaf) != sources.end();
+    for (auto it = section->begin(); it != section->end();) {
+      const std::string& other = it.key();
+      const bool same_key = other == leaf || other.rfind(leaf + "_", 0) == 0 || leaf.rfind(other + "_", 0) == 0;
+      const bool other_source = is_source && std::find(sources.begin(), sources.end(), other) != sources.end();
+      it = (same_key || other_source) && !it.value().is_object() ? section->erase(it) : std::next(it);
+    }
+    json parsed = json::parse(value, nullptr, false);
+    (*section)[leaf] = parsed.is_discarded() ? json(value) : parsed;
+  }
+  try {
+    Scene out = parse_scene(j.dump(2), "--set");
+    out.source = scene.source;
+    return out;
+  } catch (const InputError& e) {
+    // The reader names "--set:LINE: key: problem"; the line is of the generated text, so say what was set instead.
+    std::string message = e.what();
+    const size_t colon = message.rfind("--set:", 0) == 0 ? message.find(": ") : std::string::npos;
+    if (colon != std::string::npos) message = message.substr(colon + 2);
+    throw InputError(fmt::format("--set {}: {}", given, message));
+  }
 }
 
 }  // namespace needle

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "mesher/needle_mesher.h"
 #include "solver/needle/insertion_profile.h"
@@ -81,5 +82,12 @@ Scene parse_scene(const std::string& text, const std::string& source);
 
 // The effective scene, every key with its canonical unit suffix; reading it back gives the same scene.
 nlohmann::json scene_to_json(const Scene& scene);
+
+// The scene with keys set on the command line, each "section.key=value": dotted scene keys, units as in scene
+// files (tissue.material.E_MPa=0.1, motion.travel=3 cm). The value is read as JSON where it parses as such
+// (numbers, true/false, [lists]) and as text otherwise (SB, stiffening_elastic, 3 cm). Setting one of a key's
+// forms replaces the other (travel replaces travel_mm), and one needle source replaces the other. The scene
+// reader checks the result: anything it refuses (an unknown key, a bad value) is an InputError naming --set.
+Scene apply_scene_settings(const Scene& scene, const std::vector<std::string>& settings);
 
 }  // namespace needle

@@ -91,9 +91,13 @@ void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
                                scene.motion.travel_mm, o.tissue_entry_x_mm));
     scene.tissue.entry_x_mm = o.tissue_entry_x_mm;
   }
+  scene = apply_scene_settings(scene, o.settings);
 }
 
 void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
+  c->add_option("--set", o.settings,
+                "Set any scene key, KEY=VALUE with the scene file's dotted names and units, e.g. --set tissue.material.nu=0.49 "
+                "--set 'motion.travel=10 mm' (docs/scenes.md); repeatable, applied after the other flags");
   c->add_option("--travel-mm", o.travel_mm, "Insertion travel (default 30)");
   c->add_option("--spacing-mm", o.spacing_mm, "Tissue particle spacing (default 0.4)");
   c->add_option("--path-refinement", o.path_refinement,
@@ -170,6 +174,7 @@ std::string scene_override_arguments(const SceneOverrides& o) {
   auto list = [&](const char* flag, const std::vector<double>& v) {
     if (!v.empty()) line += fmt::format(" {} {}", flag, fmt::join(v, ","));
   };
+  for (const std::string& setting : o.settings) line += fmt::format(" --set '{}'", setting);
   number("--travel-mm", o.travel_mm);
   number("--spacing-mm", o.spacing_mm);
   number("--mesh-size-mm", o.mesh_size_mm);

@@ -33,13 +33,14 @@ struct SceneOverrides {
   double contact_skin_mm = std::nan("");          // the penalty contact's skin: particles are held this far off the surface (default: ContactOptions)
   double contact_stiffness_factor = std::nan(""); // the penalty's stiffness over the particle's own (default: ContactOptions)
   double tissue_entry_x_mm = std::nan("");        // the block's entry face ahead of A's start (0: at the cannula's front, the default)
+  std::vector<std::string> settings;              // --set key=value: any scene key (apply_scene_settings), applied after the flags
 };
 // InputError naming the flag for a value that is not a positive number.
 void apply_scene_overrides(Scene& scene, const SceneOverrides& overrides);
 // The flags run, paper and calibrate share: --travel-mm, --spacing-mm, --path-refinement, --no-needle-cut, --tissue-nu,
 // --tissue-friction, --tissue-law, --speed-m-per-s, --decel-time-ms, --hold-ms, --tissue-size-mm, --slit-half-height-mm, --relaxing-shear-fraction, --relaxation-time-ms, --cutting-pressure-mpa,
 // --crack-reach-mm, --crack-angles-deg, --crack-lead-mm, --groove-start-mm, --contact-skin-mm, --contact-stiffness-factor,
-// --tissue-entry-x-mm (each command
+// --tissue-entry-x-mm, and --set key=value for any scene key (each command
 // adds --mesh-size-mm itself where it has it).
 void add_scene_override_options(CLI::App* command, SceneOverrides& overrides);
 // The flags that give these overrides again (each given value, with a leading space), for a command

@@ -1,0 +1,96 @@
+// --set KEY=VALUE: any scene key set on the command line through the scene reader (apps/scene.h), and the
+// calibrated tissue that `needle run` takes by default.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "apps/scene.h"
+#include "cli_run.h"
+#include "core/input_error.h"
+#include "run_fixtures.h"
+
+namespace fs = std::filesystem;
+using namespace needle_test;
+
+TEST_CASE("apply_scene_settings sets dotted keys with units, replaces a key's other form and the needle's source, and names --set in errors",
+          "[apps][scene]") {
+  const needle::Scene base = needle::parse_scene("{}", "(test)");
+  const needle::Scene set = needle::apply_scene_settings(
+      base, {"tissue.material.nu=0.49", "motion.travel=3 cm", "tissue.size_mm=[20, 8, 4]", "needle.d_a_mm=0.1", "tissue.material.law=stiffening_elastic"});
+  CHECK(set.tissue.material.nu == 0.49);
+  CHECK(set.motion.travel_mm == Approx(30.0).epsilon(1e-12));  // "3 cm" through the reader's units, replacing travel_mm
+  CHECK(set.tissue.size_mm == Eigen::Vector3d(20, 8, 4));
+  CHECK(set.needle.d_a_mm == 0.1);
+  CHECK(set.needle.preset.empty());  // one needle source replaces the other
+  CHECK(set.tissue.material.law == needle::TissueLaw::stiffening_elastic);
+  CHECK(set.source == base.source);
+  // Everything not set is the scene's own: the effective scenes differ in the set keys only.
+  nlohmann::json a = needle::scene_to_json(base), b = needle::scene_to_json(set);
+  for (nlohmann::json* j : {&a, &b}) {
+    (*j)["tissue"]["material"].erase("nu");
+    (*j)["tissue"]["material"].erase("law");
+    (*j)["motion"].erase("travel_mm");
+    (*j)["tissue"].erase("size_mm");
+    (*j)["needle"].erase("preset");
+    (*j)["needle"].erase("d_a_mm");
+  }
+  CHECK(a == b);
+  CHECK(needle::scene_to_json(needle::apply_scene_settings(base, {})) == needle::scene_to_json(base));
+
+  auto refusal = [&](const std::string& setting) {
+    try {
+      needle::apply_scene_settings(base, {setting});
+    } catch (const needle::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  CHECK(refusal("motion.travle_mm=3") == "--set motion.travle_mm=3: motion.travle_mm: unknown key (misspelt, or without its unit suffix?)");
+  CHECK(refusal("motion.travel=3").find("--set motion.travel=3: motion.travel") == 0);  // a bare number where a unit is needed
+  CHECK(refusal("tissue.material.nu=0.7").find("--set tissue.material.nu=0.7: tissue nu must lie in (-1, 0.5) (got 0.7)") == 0);
+  CHECK(refusal("tissue.material.E_MPa") == "--set tissue.material.E_MPa: give key=value, e.g. --set tissue.material.E_MPa=0.1");
+  CHECK(refusal("tissue..nu=1").find("is not a dotted scene key") != std::string::npos);
+  CHECK(refusal("needle.length_mm.x=1").find("length_mm is a value, not a section") != std::string::npos);
+}
+
+TEST_CASE("needle run --set and needle simulate --set change the run's scene; a bad key is refused with nothing written", "[apps][lspg][gmsh]") {
+  const RunFiles set = run_rod_into_small_block("set_nu", "--set tissue.material.nu=0.4 --set tissue.friction=0.3");
+  CHECK(set.scene["tissue"]["material"]["nu"].get<double>() == 0.4);
+  CHECK(set.scene["tissue"]["friction"].get<double>() == 0.3);
+  CHECK(set.summary["status"] == "finished");
+  refused_on_small_block("set_bad", "--set tissue.material.nuu=0.4", "--set tissue.material.nuu=0.4: unknown key 'material.nuu'");
+
+  const fs::path dir = fresh_folder("simulate_set");
+  write(dir / "scene.json", R"({"needle": {"plain_rod": true, "length_mm": 6, "mesh": {"order": 1, "size_mm": 0.5}},)"
+                            R"("motion": {"accel_time_ms": 0.02, "travel_mm": 0.2}, "cannula": {"enabled": false}, "output": {"frames": 0}})");
+  const auto r = run("simulate " + (dir / "scene.json").string() + " --set motion.travel_mm=0.3 --out " + (dir / "run").string() + " --quiet", true);
+  INFO(r.out);
+  REQUIRE(r.exit_code == 0);
+  std::ifstream summary_file(dir / "run" / "summary.json");
+  CHECK(nlohmann::json::parse(summary_file)["insertion_mm"].get<double>() == Approx(0.3).epsilon(1e-9));
+}
+
+TEST_CASE("needle run with no E given takes the shipped SB calibration's and says so", "[apps][lspg][gmsh]") {
+  // The run defaults, shrunk with --set to seconds: a short T4 SB, a small block, 0.8 mm.
+  const fs::path dir = fresh_folder("calibrated_default");
+  const std::string shrink =
+      " --set needle.length_mm=26 --set needle.mesh.order=1 --set needle.mesh.size_mm=0.5 --set cannula.enabled=false"
+      " --set motion.accel_time_ms=0.02 --set motion.travel_mm=0.8 --set tissue.size_mm=[2,2.4,1.2] --set tissue.path_refinement=1"
+      " --set solver.mass_scaling_dt_ms=1e-5 --frames 0";
+  const auto r = run("run --preset SB --out " + (dir / "run").string() + shrink, true);
+  INFO(r.out);
+  REQUIRE(r.exit_code == 0);
+  std::ifstream calibration(fs::path(NEEDLE_SOURCE_DIR) / "data/paper/calibration_sb.json"), scene(dir / "run" / "scene.json");
+  const double calibrated_E = nlohmann::json::parse(calibration)["tissue_E_MPa"].get<double>();
+  CHECK(nlohmann::json::parse(scene)["tissue"]["material"]["E_MPa"].get<double>() == calibrated_E);
+  CHECK(r.out.find("calibrated on SB: ") != std::string::npos);
+  CHECK(r.out.find("data/paper/calibration_sb.json") != std::string::npos);
+
+  // --tissue-E-MPa and --set override it, and say so.
+  const auto given = run("run --preset SB --tissue-E-MPa 0.2 --out " + (dir / "given").string() + shrink, true);
+  CHECK(given.out.find("tissue E 0.2 MPa, given with --tissue-E-MPa") != std::string::npos);
+  const auto set = run("run --preset SB --set tissue.material.E_MPa=0.3 --out " + (dir / "set").string() + shrink, true);
+  CHECK(set.out.find("tissue E 0.3 MPa, given with --set") != std::string::npos);
+}
