@@ -16,11 +16,11 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
-#include "apps/calibration_steps.h"
-#include "apps/insertion_run.h"
+#include "studies/calibration_steps.h"
+#include "runs/insertion_run.h"
 #include "apps/scene_overrides.h"
-#include "apps/json_file.h"
-#include "apps/scene.h"
+#include "runs/json_file.h"
+#include "runs/scene.h"
 #include "core/input_error.h"
 #include "geometry/mesh_io.h"
 #include "plot/line_plot.h"

@@ -10,7 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
-#include "apps/material_json.h"
+#include "runs/material_json.h"
 #include "core/input_error.h"
 #include "geometry/mesh_io.h"
 #include "plot/line_plot.h"

@@ -11,11 +11,11 @@
 #include <sstream>
 #include <tuple>
 
-#include "apps/insertion_run.h"
+#include "runs/insertion_run.h"
 #include "apps/scene_overrides.h"
-#include "apps/json_file.h"
-#include "apps/paper_report.h"
-#include "apps/scene.h"
+#include "runs/json_file.h"
+#include "studies/paper_report.h"
+#include "runs/scene.h"
 #include "core/input_error.h"
 
 #ifndef NEEDLE_DATA_DIR

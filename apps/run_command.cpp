@@ -6,9 +6,9 @@
 #include <fmt/format.h>
 #include <memory>
 
-#include "apps/insertion_run.h"
+#include "runs/insertion_run.h"
 #include "apps/scene_overrides.h"
-#include "apps/scene.h"
+#include "runs/scene.h"
 #include "core/input_error.h"
 
 namespace needle {

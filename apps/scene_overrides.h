@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "apps/scene.h"
+#include "runs/scene.h"
 
 namespace needle {
 

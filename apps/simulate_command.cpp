@@ -5,9 +5,9 @@
 
 #include <memory>
 
-#include "apps/insertion_run.h"
-#include "apps/needle_alone_run.h"
-#include "apps/scene.h"
+#include "runs/insertion_run.h"
+#include "runs/needle_alone_run.h"
+#include "runs/scene.h"
 
 namespace needle {
 namespace {

@@ -9,7 +9,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
-#include "apps/needle_build.h"
+#include "runs/needle_build.h"
 #include "apps/tip_source.h"
 #include "geometry/exact_measures.h"
 #include "core/input_error.h"

@@ -5,7 +5,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "apps/recipe_json.h"
+#include "runs/recipe_json.h"
 #include "apps/tip_source.h"
 #include "geometry/cad_solid.h"
 #include "core/input_error.h"

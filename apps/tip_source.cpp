@@ -1,6 +1,6 @@
 #include "apps/tip_source.h"
 
-#include "apps/recipe_json.h"
+#include "runs/recipe_json.h"
 #include "core/input_error.h"
 
 namespace needle {

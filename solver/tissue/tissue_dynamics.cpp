@@ -151,9 +151,10 @@ double TissueDynamics::kick_and_drift(double max_dt_ms) {
 
 StepReport TissueDynamics::finish_step(const std::vector<Vec3d>* external_force_N) {
   NEEDLE_REQUIRE(drifted_, "finish_step needs kick_and_drift first");
-  drifted_ = false;
   TissueParticles& p = tissue_.particles();
   const std::int64_t n = p.size();
+  NEEDLE_REQUIRE(!external_force_N || external_force_N->size() == static_cast<size_t>(n), "external forces need one force per particle");
+  drifted_ = false;
   const double dt = step_dt_ms_;
   const std::vector<Vec3d>& old_force = old_force_;
   const std::vector<Vec3d>& displacement = displacement_;
@@ -164,7 +165,6 @@ StepReport TissueDynamics::finish_step(const std::vector<Vec3d>* external_force_
   report.rate_factor_capped = forces.rate_factor_capped;
   report.particles_detached_now = forces.particles_detached_now;
   if (external_force_N) {
-    NEEDLE_REQUIRE(external_force_N->size() == static_cast<size_t>(n), "external forces need one force per particle");
     old_external_force_.swap(external_force_);
     external_force_ = *external_force_N;
   } else {

@@ -7,8 +7,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "apps/csv_table.h"
-#include "apps/scene.h"
+#include "runs/csv_table.h"
+#include "runs/scene.h"
 #include "cli_run.h"
 #include "core/input_error.h"
 

@@ -7,9 +7,9 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "apps/insertion_run.h"
+#include "runs/insertion_run.h"
 #include "apps/scene_overrides.h"
-#include "apps/scene.h"
+#include "runs/scene.h"
 #include "cli_run.h"
 
 namespace fs = std::filesystem;

@@ -9,9 +9,9 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "apps/csv_table.h"
-#include "apps/scene.h"
-#include "apps/scene_needle.h"
+#include "runs/csv_table.h"
+#include "runs/scene.h"
+#include "runs/scene_needle.h"
 #include "cli_run.h"
 #include "run_fixtures.h"
 

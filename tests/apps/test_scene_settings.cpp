@@ -6,7 +6,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "apps/scene.h"
+#include "runs/scene.h"
 #include "cli_run.h"
 #include "core/input_error.h"
 #include "run_fixtures.h"

@@ -10,9 +10,9 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "apps/csv_table.h"
-#include "apps/scene.h"
-#include "apps/scene_needle.h"
+#include "runs/csv_table.h"
+#include "runs/scene.h"
+#include "runs/scene_needle.h"
 #include "cli_run.h"
 #include "run_fixtures.h"
 #include "core/input_error.h"

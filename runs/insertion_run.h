@@ -1,0 +1,36 @@
+#pragma once
+// The coupled L-SPG insertion of a scene (tissue.enabled): needle, particles, contact, solve, and the
+// run folder (docs/scenes.md): scene.json, history.csv, facet_forces.csv, summary.json, needle.pvd and
+// tissue.pvd with frames/, run.log. Used by `needle simulate` and `needle run`.
+#include <string>
+
+#include "runs/run_driver.h"
+#include "runs/scene.h"
+
+namespace needle {
+
+
+// The run defaults of `needle run` and `needle paper`: the paper's scene with tissue, and the needle
+// fidelity that keeps a 30 mm run within minutes (docs/insertion.md measures its error). The tissue's E is
+// the card's (0.665 MPa); `needle run` replaces it by the calibrated one (default_calibration_file()).
+Scene default_run_scene();
+
+// The SB calibration shipped with the toolkit (data/paper/calibration_sb.json): the E that makes the paper's
+// SB deflect as measured, which `needle run` uses unless told otherwise.
+std::string default_calibration_file();
+// E from a calibration file written by `needle calibrate` (its tissue_E_MPa); InputError naming the file otherwise.
+double calibrated_E(const std::string& path);
+
+// InputError (nothing written) for bad input; SolverError after writing the folder if the solver stopped
+// (unless !throw_on_stop).
+void run_insertion(const Scene& scene, const RunOptions& options);
+
+// Runs the scene into options.out_dir unless that folder already holds a run (summary.json) of exactly
+// this scene (scene.json, threads aside); true if it reused one. An interrupted `paper` or `calibrate` resumes this way.
+bool run_insertion_unless_done(const Scene& scene, const RunOptions& options);
+
+// Whether folder holds a run (summary.json, finished or stopped) of exactly this scene (scene.json), whatever
+// worker threads it ran on (solver.threads, which does not change a run's results).
+bool folder_holds_run_of(const Scene& scene, const std::string& folder);
+
+}  // namespace needle

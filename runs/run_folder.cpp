@@ -1,0 +1,97 @@
+#include "runs/run_folder.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <fmt/format.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include "core/input_error.h"
+
+namespace needle {
+namespace {
+
+double now_s() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
+
+std::string clock_text(double seconds) {
+  const long s = static_cast<long>(seconds + 0.5);
+  return s >= 3600 ? fmt::format("{}:{:02}:{:02}", s / 3600, s / 60 % 60, s % 60) : fmt::format("{}:{:02}", s / 60, s % 60);
+}
+
+}  // namespace
+
+RunFolder::RunFolder(const std::string& dir, bool overwrite) : final_(dir), overwrite_(overwrite) {
+  NEEDLE_REQUIRE(!dir.empty(), "--out needs a folder");
+  std::filesystem::path parent = std::filesystem::absolute(final_).parent_path();
+  NEEDLE_REQUIRE(std::filesystem::is_directory(parent), fmt::format("the folder '{}' that should hold '{}' does not exist", parent.string(), dir));
+  NEEDLE_REQUIRE(overwrite || !std::filesystem::exists(final_),
+                 fmt::format("'{}' already exists; choose another --out or pass --overwrite", dir));
+  partial_ = parent / ("." + final_.filename().string() + ".partial");
+  std::filesystem::remove_all(partial_);
+  std::filesystem::create_directories(partial_);
+}
+
+RunFolder::~RunFolder() {
+  if (!committed_) {
+    std::error_code ignored;
+    std::filesystem::remove_all(partial_, ignored);
+  }
+}
+
+void RunFolder::commit() {
+  if (overwrite_ && std::filesystem::exists(final_)) std::filesystem::remove_all(final_);
+  std::filesystem::rename(partial_, final_);
+  committed_ = true;
+}
+
+RunLog::RunLog(const std::filesystem::path& path) : out_(path), start_s_(now_s()) {
+  NEEDLE_REQUIRE(out_.good(), fmt::format("cannot write the log '{}'", path.string()));
+}
+
+void RunLog::line(const std::string& text) {
+  out_ << fmt::format("[{:9.3f} s] {}\n", now_s() - start_s_, text);
+  out_.flush();
+}
+
+ProgressBar::ProgressBar(double end_value, bool quiet) : end_(end_value), start_s_(now_s()), quiet_(quiet), tty_(isatty(2)) {}
+
+void ProgressBar::update(double value, long step, const std::string& unit) {
+  if (quiet_ || end_ <= 0) return;
+  const double fraction = std::clamp(value / end_, 0.0, 1.0), elapsed = now_s() - start_s_;
+  const std::string eta = fraction > 1e-6 ? clock_text(elapsed * (1 - fraction) / fraction) : "?";
+  if (tty_) {
+    if (now_s() - last_draw_s_ < 0.2 && fraction < 1) return;
+    last_draw_s_ = now_s();
+    const int width = 30, filled = static_cast<int>(fraction * width);
+    fmt::print(stderr, "\r{:3.0f}% [{}{}] step {}  t {:.4g}/{:.4g} {}  elapsed {}  ETA {}   ", 100 * fraction,
+               std::string(static_cast<size_t>(filled), '#'), std::string(static_cast<size_t>(width - filled), '.'), step, value,
+               end_, unit, clock_text(elapsed), eta);
+    std::fflush(stderr);
+    return;
+  }
+  const int decile = static_cast<int>(fraction * 10);
+  if (decile == last_decile_) return;
+  last_decile_ = decile;
+  fmt::print(stderr, "{:3.0f}%  step {}  t {:.4g}/{:.4g} {}  elapsed {}  ETA {}\n", 100 * fraction, step, value, end_, unit,
+             clock_text(elapsed), eta);
+}
+
+void ProgressBar::finish() {
+  if (!quiet_ && tty_) fmt::print(stderr, "\n");
+}
+
+void write_pvd(const std::filesystem::path& path, const std::vector<std::pair<double, std::string>>& frames) {
+  std::ofstream out(path);
+  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n";
+  for (const auto& [time, file] : frames) out << fmt::format("    <DataSet timestep=\"{:.9g}\" file=\"{}\"/>\n", time, file);
+  out << "  </Collection>\n</VTKFile>\n";
+}
+
+double peak_memory_MiB() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;
+}
+
+}  // namespace needle

@@ -1,0 +1,327 @@
+#include "runs/scene.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <fmt/format.h>
+
+#include "runs/json_lines.h"
+#include "runs/material_json.h"
+#include "runs/scene_object.h"
+#include "core/input_error.h"
+#include "solver/needle/needle_models.h"
+
+namespace needle {
+namespace {
+
+using nlohmann::json;
+
+void read_needle(SceneObject o, NeedleScene& n, const std::string& scene_folder) {
+  n.preset = o.text("preset", "");
+  n.d_a_mm = o.quantity("d_a", Dimension::length, n.d_a_mm, any_finite());
+  n.recipe_file = o.text("recipe", "");
+  n.mesh_file = o.text("mesh_file", "");
+  n.plain_rod = o.boolean("plain_rod", false);
+  const int sources = !n.preset.empty() + !std::isnan(n.d_a_mm) + !n.recipe_file.empty() + !n.mesh_file.empty() + n.plain_rod;
+  NEEDLE_REQUIRE(sources <= 1, fmt::format("{}: give one of preset, d_a_mm, recipe, mesh_file or plain_rod", o.where("preset")));
+  if (sources == 0) n.preset = "SB";
+  for (std::string* file : {&n.recipe_file, &n.mesh_file}) {
+    if (file->empty()) continue;
+    const std::string key = file == &n.recipe_file ? "recipe" : "mesh_file";
+    std::filesystem::path p(*file);
+    if (p.is_relative()) p = std::filesystem::path(scene_folder) / p;
+    NEEDLE_REQUIRE(std::filesystem::is_regular_file(p), fmt::format("{}: file '{}' does not exist", o.where(key), p.string()));
+    *file = p.string();
+  }
+  n.length_mm = o.quantity("length", Dimension::length, n.length_mm, positive());
+  n.groove_start_mm = o.quantity("groove_start", Dimension::length, n.groove_start_mm, positive());
+  NEEDLE_REQUIRE(std::isnan(n.groove_start_mm) || (n.mesh_file.empty() && !n.plain_rod),
+                 fmt::format("{}: a groove start moves the groove of a ground tip (a preset, d_a_mm or a recipe), not of a plain "
+                             "rod or a mesh file", o.where("groove_start_mm")));
+  n.half_model = o.boolean("half_model", n.half_model);
+  if (o.has("mesh")) {
+    SceneObject m = o.child("mesh");
+    n.mesh.order = m.integer("order", n.mesh.order, 1, 2);
+    n.mesh.size_mm = m.quantity("size", Dimension::length, n.mesh.size_mm, positive());
+    n.mesh.tip_size_mm = m.quantity("tip_size", Dimension::length, n.mesh.tip_size_mm, non_negative());
+    n.mesh.edge_size_mm = m.quantity("edge_size", Dimension::length, n.mesh.edge_size_mm, non_negative());
+    n.mesh.shaft_size_mm = m.quantity("shaft_size", Dimension::length, n.mesh.shaft_size_mm, non_negative());
+    n.mesh.grading_mm = m.quantity("grading", Dimension::length, n.mesh.grading_mm, positive());
+    m.finish();
+    try {
+      n.mesh.resolved();
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("{}: {}", o.where("mesh"), e.what()));
+    }
+  }
+  if (o.has("material")) {
+    SceneObject m = o.child("material");
+    n.material.youngs_modulus_MPa = m.quantity("youngs_modulus", Dimension::stress, n.material.youngs_modulus_MPa, positive());
+    n.material.poisson_ratio = m.number("poisson_ratio", n.material.poisson_ratio, within(-0.999, 0.499));
+    n.material.density_g_per_mm3 = m.quantity("density", Dimension::density, n.material.density_g_per_mm3, positive());
+    m.finish();
+  }
+  // needle.model names a registered needle model (solver/needle/needle_models.h); rigid: true is the older
+  // way to say model "rigid", and the effective scene still says it so that stored scenes read the same.
+  n.model = o.text("model", n.model);
+  require_needle_model(n.model, o.where("model"));
+  if (o.boolean("rigid", n.model == "rigid")) {
+    NEEDLE_REQUIRE(n.model == "fe" || n.model == "rigid", fmt::format("{}: rigid: true contradicts model '{}'", o.where("rigid"), n.model));
+    n.model = "rigid";
+  }
+  o.finish();
+}
+
+void read_motion(SceneObject o, Scene& s) {
+  InsertionProfile& p = s.motion;
+  p.accel_time_ms = o.quantity("accel_time", Dimension::time, p.accel_time_ms, non_negative());
+  p.speed_mm_per_ms = o.quantity("speed", Dimension::speed, p.speed_mm_per_ms, positive());
+  p.travel_mm = o.quantity("travel", Dimension::length, p.travel_mm, positive());
+  p.decel_time_ms = o.quantity("decel_time", Dimension::time, p.decel_time_ms, non_negative());
+  p.hold_ms = o.quantity("hold", Dimension::time, p.hold_ms, non_negative());
+  s.direction = o.vector3("direction", s.direction);
+  NEEDLE_REQUIRE(s.direction.allFinite() && s.direction.norm() > 0, fmt::format("{} must be a non-zero vector", o.where("direction")));
+  try {
+    p.validate("motion");
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("{}: {}", o.where("travel_mm"), e.what()));
+  }
+  o.finish();
+}
+
+void read_cannula(SceneObject o, CannulaOptions& c) {
+  c.enabled = o.boolean("enabled", c.enabled);
+  c.outer_diameter_mm = o.quantity("outer_diameter", Dimension::length, c.outer_diameter_mm, positive());
+  c.wall_mm = o.quantity("wall", Dimension::length, c.wall_mm, positive());
+  c.front_x_mm = o.quantity("front_x", Dimension::length, c.front_x_mm, any_finite());
+  c.length_mm = o.quantity("length", Dimension::length, c.length_mm, positive());
+  c.friction = o.number("friction", c.friction, non_negative());
+  c.penalty_scale = o.number("penalty_scale", c.penalty_scale, within(1e-6, 0.5));
+  NEEDLE_REQUIRE(c.wall_mm < 0.5 * c.outer_diameter_mm, fmt::format("{}: the wall leaves no bore", o.where("wall_mm")));
+  o.finish();
+}
+
+void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc) {
+  t.enabled = o.boolean("enabled", t.enabled);
+  t.size_mm = o.vector3("size_mm", t.size_mm);
+  NEEDLE_REQUIRE((t.size_mm.array() > 0).all(), fmt::format("{} must be three positive lengths", o.where("size_mm")));
+  t.entry_x_mm = o.quantity("entry_x", Dimension::length, t.entry_x_mm, any_finite());
+  t.spacing_mm = o.quantity("spacing", Dimension::length, t.spacing_mm, positive());
+  t.path_refinement = o.integer("path_refinement", t.path_refinement, 1, 8);
+  t.path_half_width_mm = o.quantity("path_half_width", Dimension::length, t.path_half_width_mm, positive());
+  t.dilation = o.number("dilation", t.dilation, within(1.0, 4.0));
+  t.spg.dilation = t.dilation;
+  t.friction = o.number("friction", t.friction, non_negative());
+  t.contact.friction = t.friction;
+  if (o.has("material")) t.material = material_from_json(o.raw("material"), doc.where("/tissue/material"), t.material);
+  t.material.validate();
+  if (o.has("spg")) {
+    SceneObject g = o.child("spg");
+    const auto name = [&](const std::string& key, const std::string& fallback, auto parse) {
+      const std::string value = g.text(key, fallback);
+      try {
+        return parse(value);
+      } catch (const InputError& e) {
+        throw InputError(fmt::format("{}: {}", g.where(key), e.what()));
+      }
+    };
+    t.spg.kernel_update = name("kernel_update", kernel_update_name(t.spg.kernel_update), kernel_update_from_name);
+    t.spg.kernel_update_interval_steps = g.integer("kernel_update_interval_steps", t.spg.kernel_update_interval_steps, 1, 1000000);
+    t.spg.stabilization = name("stabilization", stabilization_name(t.spg.stabilization), stabilization_from_name);
+    t.spg.stabilization_coefficient = g.number("stabilization_coefficient", t.spg.stabilization_coefficient, within(0.0, 10.0));
+    t.spg.smoothing_interval_steps = g.integer("smoothing_interval_steps", t.spg.smoothing_interval_steps, 1, 1000000);
+    t.spg.bond_failure.enabled = g.boolean("bond_failure", t.spg.bond_failure.enabled);
+    t.spg.bond_failure.measure = name("failure_measure", failure_measure_name(t.spg.bond_failure.measure), failure_measure_from_name);
+    t.spg.bond_failure.strain = g.number("failure_strain", t.spg.bond_failure.strain, positive());
+    t.spg.bond_failure.stretch_ratio = g.number("failure_stretch_ratio", t.spg.bond_failure.stretch_ratio, non_negative());
+    t.spg.crack_face_min_volume_ratio = g.number("crack_face_min_volume_ratio", t.spg.crack_face_min_volume_ratio, within(0.0, 0.99));
+    t.spg.cfl = g.number("cfl", t.spg.cfl, within(1e-3, 1.0));
+    g.finish();
+  }
+  if (o.has("contact")) {
+    SceneObject c = o.child("contact");
+    t.contact.stiffness_factor = c.number("stiffness_factor", t.contact.stiffness_factor, within(1e-3, 1e4));
+    t.contact.skin_mm = c.quantity("skin", Dimension::length, t.contact.skin_mm, non_negative());
+    t.contact.voxel_mm = c.quantity("voxel", Dimension::length, t.contact.voxel_mm, within(1e-3, 0.2));
+    t.contact.damping_ratio = c.number("damping_ratio", t.contact.damping_ratio, within(0.0, 1.0));
+    t.contact.needle_stiffness_scale = c.number("needle_stiffness_scale", t.contact.needle_stiffness_scale, within(1e-6, 0.5));
+    t.separation.needle_cut = c.boolean("cuts_bonds", t.separation.needle_cut);
+    t.separation.slit.half_height_mm = c.quantity("slit_half_height", Dimension::length, t.separation.slit.half_height_mm, non_negative());
+    t.separation.slit.lead_mm = c.quantity("slit_lead", Dimension::length, t.separation.slit.lead_mm, non_negative());
+    t.contact.cutting_pressure_MPa = c.quantity("cutting_pressure", Dimension::stress, t.contact.cutting_pressure_MPa, non_negative());
+    t.separation.crack.reach_mm = c.quantity("crack_reach", Dimension::length, t.separation.crack.reach_mm, non_negative());
+    t.separation.crack.angles_deg = c.numbers("crack_angles_deg", t.separation.crack.angles_deg, within(-180.0, 180.0));
+    t.separation.crack.lead_mm = c.quantity("crack_lead", Dimension::length, t.separation.crack.lead_mm, non_negative());
+    c.finish();
+  }
+  o.finish();
+}
+
+void read_solver(SceneObject o, SolverScene& s) {
+  s.courant = o.number("courant", s.courant, within(1e-3, 1.0));
+  s.mass_scaling_dt_ms = o.quantity("mass_scaling_dt", Dimension::time, s.mass_scaling_dt_ms, non_negative());
+  s.max_energy_error = o.number("max_energy_error", s.max_energy_error, positive());
+  s.max_penetration_mm = o.quantity("max_penetration", Dimension::length, s.max_penetration_mm, positive());
+  s.threads = o.integer("threads", s.threads, 0, 1024);
+  CouplingOptions& c = s.coupling;
+  c.subcycling = o.boolean("subcycling", c.subcycling);
+  c.max_step_ms = o.quantity("max_coupling_step", Dimension::time, c.max_step_ms, non_negative());
+  c.contact_courant = o.number("contact_courant", c.contact_courant, within(1e-3, 1.0));
+  c.max_energy_error = s.max_energy_error;
+  c.max_depth_mm = o.quantity("max_contact_depth", Dimension::length, c.max_depth_mm, positive());
+  o.finish();
+}
+
+void read_output(SceneObject o, OutputScene& out) {
+  out.history_interval_ms = o.quantity("history_interval", Dimension::time, out.history_interval_ms, positive());
+  out.frames = o.integer("frames", out.frames, 0, 10000);
+  o.finish();
+}
+
+Scene scene_from_document(const JsonDocument& doc) {
+  Scene s;
+  s.source = doc.source;
+  const std::string folder = std::filesystem::path(doc.source).parent_path().string();
+  SceneObject root(doc, "", "");
+  if (root.has("needle")) read_needle(root.child("needle"), s.needle, folder);
+  else s.needle.preset = "SB";
+  if (root.has("motion")) read_motion(root.child("motion"), s);
+  if (root.has("cannula")) read_cannula(root.child("cannula"), s.cannula);
+  if (root.has("tissue")) read_tissue(root.child("tissue"), s.tissue, doc);
+  if (root.has("solver")) read_solver(root.child("solver"), s.solver);
+  if (root.has("output")) read_output(root.child("output"), s.output);
+  root.text("description", "");
+  root.finish();
+  return s;
+}
+
+json vector_json(const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); }
+
+}  // namespace
+
+Scene parse_scene(const std::string& text, const std::string& source) {
+  return scene_from_document(parse_json_with_lines(text, source));
+}
+
+Scene read_scene(const std::string& path) { return scene_from_document(read_json_with_lines(path)); }
+
+json scene_to_json(const Scene& s) {
+  const NeedleScene& n = s.needle;
+  json needle = {{"length_mm", n.length_mm}, {"half_model", n.half_model}};
+  if (!n.preset.empty()) needle["preset"] = n.preset;
+  if (!std::isnan(n.d_a_mm)) needle["d_a_mm"] = n.d_a_mm;
+  if (!n.recipe_file.empty()) needle["recipe"] = std::filesystem::absolute(n.recipe_file).string();
+  if (!n.mesh_file.empty()) needle["mesh_file"] = std::filesystem::absolute(n.mesh_file).string();
+  if (n.plain_rod) needle["plain_rod"] = true;
+  if (!std::isnan(n.groove_start_mm)) needle["groove_start_mm"] = n.groove_start_mm;
+  needle["mesh"] = {{"order", n.mesh.order}, {"size_mm", n.mesh.size_mm}, {"tip_size_mm", n.mesh.tip_size_mm},
+                    {"edge_size_mm", n.mesh.edge_size_mm}, {"shaft_size_mm", n.mesh.shaft_size_mm}, {"grading_mm", n.mesh.grading_mm}};
+  needle["material"] = {{"youngs_modulus_MPa", n.material.youngs_modulus_MPa}, {"poisson_ratio", n.material.poisson_ratio},
+                        {"density_g_per_cm3", n.material.density_g_per_mm3 * 1e3}};
+  needle["rigid"] = n.model == "rigid";
+  if (n.model != "fe" && n.model != "rigid") needle["model"] = n.model;
+  const TissueScene& t = s.tissue;
+  json tissue = {
+      {"enabled", t.enabled}, {"size_mm", vector_json(t.size_mm)}, {"entry_x_mm", t.entry_x_mm}, {"spacing_mm", t.spacing_mm},
+      {"path_refinement", t.path_refinement}, {"path_half_width_mm", t.path_half_width_mm},
+      {"dilation", t.dilation}, {"friction", t.friction}, {"material", material_to_json(t.material)},
+      {"spg", {{"kernel_update", kernel_update_name(t.spg.kernel_update)},
+               {"kernel_update_interval_steps", t.spg.kernel_update_interval_steps},
+               {"stabilization", stabilization_name(t.spg.stabilization)},
+               {"stabilization_coefficient", t.spg.stabilization_coefficient},
+               {"smoothing_interval_steps", t.spg.smoothing_interval_steps},
+               {"bond_failure", t.spg.bond_failure.enabled},
+               {"failure_measure", failure_measure_name(t.spg.bond_failure.measure)},
+               {"failure_strain", t.spg.bond_failure.strain},
+               {"failure_stretch_ratio", t.spg.bond_failure.stretch_ratio},
+               {"crack_face_min_volume_ratio", t.spg.crack_face_min_volume_ratio},
+               {"cfl", t.spg.cfl}}},
+      {"contact", {{"stiffness_factor", t.contact.stiffness_factor}, {"skin_mm", t.contact.skin_mm}, {"voxel_mm", t.contact.voxel_mm},
+                   {"damping_ratio", t.contact.damping_ratio}, {"needle_stiffness_scale", t.contact.needle_stiffness_scale},
+                   {"cuts_bonds", t.separation.needle_cut}}}};
+  // Written only when used: stored scenes (no slit) stay as they were.
+  if (t.separation.slit.enabled()) {
+    tissue["contact"]["slit_half_height_mm"] = t.separation.slit.half_height_mm;
+    tissue["contact"]["slit_lead_mm"] = t.separation.slit.lead_mm;
+  }
+  if (t.contact.cutting_pressure_MPa > 0) tissue["contact"]["cutting_pressure_MPa"] = t.contact.cutting_pressure_MPa;
+  if (t.separation.crack.enabled()) {
+    tissue["contact"]["crack_reach_mm"] = t.separation.crack.reach_mm;
+    tissue["contact"]["crack_angles_deg"] = t.separation.crack.angles_deg;
+    tissue["contact"]["crack_lead_mm"] = t.separation.crack.lead_mm;
+  }
+  const CannulaOptions& c = s.cannula;
+  json motion = {{"accel_time_ms", s.motion.accel_time_ms}, {"speed_m_per_s", s.motion.speed_mm_per_ms}, {"travel_mm", s.motion.travel_mm},
+                 {"direction", vector_json(s.direction)}};
+  // Written only when used: stored scenes (the paper's model, neither) stay as they were.
+  if (s.motion.decel_time_ms > 0) motion["decel_time_ms"] = s.motion.decel_time_ms;
+  if (s.motion.hold_ms > 0) motion["hold_ms"] = s.motion.hold_ms;
+  return {
+      {"needle", needle},
+      {"motion", motion},
+      {"cannula", {{"enabled", c.enabled}, {"outer_diameter_mm", c.outer_diameter_mm}, {"wall_mm", c.wall_mm},
+                   {"front_x_mm", c.front_x_mm}, {"length_mm", c.length_mm}, {"friction", c.friction},
+                   {"penalty_scale", c.penalty_scale}}},
+      {"tissue", tissue},
+      {"solver", {{"courant", s.solver.courant}, {"mass_scaling_dt_ms", s.solver.mass_scaling_dt_ms},
+                  {"max_energy_error", s.solver.max_energy_error}, {"max_penetration_mm", s.solver.max_penetration_mm},
+                  {"threads", s.solver.threads}, {"subcycling", s.solver.coupling.subcycling},
+                  {"max_coupling_step_ms", s.solver.coupling.max_step_ms}, {"contact_courant", s.solver.coupling.contact_courant},
+                  {"max_contact_depth_mm", s.solver.coupling.max_depth_mm}}},
+      {"output", {{"history_interval_ms", s.output.history_interval_ms}, {"frames", s.output.frames}}},
+  };
+}
+
+}  // namespace needle
+
+namespace needle {
+
+Scene apply_scene_settings(const Scene& scene, const std::vector<std::string>& settings) {
+  if (settings.empty()) return scene;
+  json j = scene_to_json(scene);
+  std::string given;
+  for (const std::string& setting : settings) {
+    given += (given.empty() ? "" : " ") + setting;
+    const size_t eq = setting.find('=');
+    NEEDLE_REQUIRE(eq != std::string::npos && eq > 0, fmt::format("--set {}: give key=value, e.g. --set tissue.material.E_MPa=0.1", setting));
+    const std::string key = setting.substr(0, eq), value = setting.substr(eq + 1);
+    std::vector<std::string> path;
+    for (size_t start = 0;;) {
+      const size_t dot = key.find('.', start);
+      path.push_back(key.substr(start, dot == std::string::npos ? std::string::npos : dot - start));
+      NEEDLE_REQUIRE(!path.back().empty(), fmt::format("--set {}: '{}' is not a dotted scene key (docs/scenes.md)", setting, key));
+      if (dot == std::string::npos) break;
+      start = dot + 1;
+    }
+    json* section = &j;
+    for (size_t k = 0; k + 1 < path.size(); ++k) {
+      json& next = (*section)[path[k]];
+      if (next.is_null()) next = json::object();
+      NEEDLE_REQUIRE(next.is_object(), fmt::format("--set {}: {} is a value, not a section", setting, path[k]));
+      section = &next;
+    }
+    const std::string& leaf = path.back();
+    static const std::vector<std::string> sources = {"preset", "d_a_mm", "d_a", "recipe", "mesh_file", "plain_rod"};
+    const bool is_source = path.size() == 2 && path[0] == "needle" && std::find(sources.begin(), sources.end(), leaf) != sources.end();
+    for (auto it = section->begin(); it != section->end();) {
+      const std::string& other = it.key();
+      const bool same_key = other == leaf || other.rfind(leaf + "_", 0) == 0 || leaf.rfind(other + "_", 0) == 0;
+      const bool other_source = is_source && std::find(sources.begin(), sources.end(), other) != sources.end();
+      it = (same_key || other_source) && !it.value().is_object() ? section->erase(it) : std::next(it);
+    }
+    json parsed = json::parse(value, nullptr, false);
+    (*section)[leaf] = parsed.is_discarded() ? json(value) : parsed;
+  }
+  try {
+    Scene out = parse_scene(j.dump(2), "--set");
+    out.source = scene.source;
+    return out;
+  } catch (const InputError& e) {
+    // The reader names "--set:LINE: key: problem"; the line is of the generated text, so say what was set instead.
+    std::string message = e.what();
+    const size_t colon = message.rfind("--set:", 0) == 0 ? message.find(": ") : std::string::npos;
+    if (colon != std::string::npos) message = message.substr(colon + 2);
+    throw InputError(fmt::format("--set {}: {}", given, message));
+  }
+}
+
+}  // namespace needle
