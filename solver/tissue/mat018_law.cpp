@@ -1,0 +1,71 @@
+#include "solver/tissue/mat018_law.h"
+
+#include <cmath>
+
+namespace needle {
+
+double TissueMaterial::yield_strain() const { return std::pow(E_MPa / k_MPa, 1.0 / (n - 1.0)); }
+
+double TissueMaterial::rate_factor(double strain_rate_per_ms, bool* capped) const {
+  if (capped) *capped = false;
+  if (rate_law == RateLaw::off || !(strain_rate_per_ms > 0)) return 1.0;
+  const double exponent = rate_law == RateLaw::printed ? 1.0 / rate_p : rate_p;
+  const double log_term = exponent * std::log(strain_rate_per_ms / rate_C_per_ms);
+  const double log_cap = std::log(max_rate_factor - 1.0 > 0 ? max_rate_factor - 1.0 : 1e-300);
+  if (log_term >= log_cap) {
+    if (capped) *capped = true;
+    return max_rate_factor;
+  }
+  return 1.0 + std::exp(log_term);
+}
+
+double TissueMaterial::yield_stress_MPa(double plastic_strain, double factor) const {
+  return factor * k_MPa * std::pow(yield_strain() + plastic_strain, n);
+}
+
+double TissueMaterial::hardening_slope_MPa(double plastic_strain, double factor) const {
+  return factor * k_MPa * n * std::pow(yield_strain() + plastic_strain, n - 1.0);
+}
+
+Eigen::Vector3d mat018_deviatoric_stress(const TissueMaterial& m, double rate, const Eigen::Vector3d& h_dev, Eigen::Vector3d& h, double& eps_p,
+                                         bool& capped) {
+  const double factor = m.rate_factor(rate, &capped);
+  const double mu = m.shear_modulus_MPa();
+  Eigen::Vector3d s = 2 * mu * h_dev;  // principal deviatoric Cauchy stress
+  const double q_trial = std::sqrt(1.5 * s.squaredNorm());
+  if (q_trial > m.yield_stress_MPa(eps_p, factor)) {
+    // Radial return: q_trial - 3 mu dg = sigma_y(eps_p + dg); Newton with bisection bounds.
+    double lo = 0.0, hi = q_trial / (3 * mu), dg = 0.0;
+    for (int it = 0; it < 60; ++it) {
+      const double residual = q_trial - 3 * mu * dg - m.yield_stress_MPa(eps_p + dg, factor);
+      if (residual > 0) lo = dg; else hi = dg;
+      if (std::abs(residual) < 1e-12 * q_trial) break;
+      double next = dg + residual / (3 * mu + m.hardening_slope_MPa(eps_p + dg, factor));
+      if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+      dg = next;
+    }
+    const Eigen::Vector3d flow = 1.5 * s / q_trial;  // unit plastic flow direction (deviatoric)
+    h -= dg * flow;
+    s *= 1.0 - 3 * mu * dg / q_trial;
+    eps_p += dg;
+  }
+  return s;
+}
+
+double mat018_uniaxial_true_stress_MPa(const TissueMaterial& m, double true_strain, double strain_rate_per_ms) {
+  const double factor = m.rate_factor(strain_rate_per_ms);
+  const double eps = std::abs(true_strain);
+  const double elastic = m.E_MPa * eps;
+  if (elastic <= m.yield_stress_MPa(0.0, factor)) return true_strain < 0 ? -elastic : elastic;
+  // Plastic: find eps_p in [0, eps] with  E (eps - eps_p) = sigma_y(eps_p); the left side falls and the
+  // right side rises with eps_p, so the root is unique.
+  double lo = 0.0, hi = eps;
+  for (int it = 0; it < 200; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    if (m.E_MPa * (eps - mid) > m.yield_stress_MPa(mid, factor)) lo = mid; else hi = mid;
+  }
+  const double stress = m.yield_stress_MPa(0.5 * (lo + hi), factor);
+  return true_strain < 0 ? -stress : stress;
+}
+
+}  // namespace needle
