@@ -19,7 +19,7 @@ namespace needle {
 enum class FaceCondition { free, fixed, symmetry };
 
 // Particle flags (bits): a particle on two faces carries both faces' flags. kParticleOpenSymmetry is set
-// during a run (solver/symmetry_slit.h): a symmetry particle a crack in the plane has released keeps
+// during a run (solver/separation/symmetry_slit.h): a symmetry particle a crack in the plane has released keeps
 // z >= 0 only, its mirror image being its contact partner.
 enum ParticleFlag : std::uint8_t { kParticleFixed = 1, kParticleSymmetry = 2, kParticleFreeSurface = 4, kParticleOpenSymmetry = 8 };
 

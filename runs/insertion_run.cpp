@@ -317,7 +317,7 @@ bool folder_holds_run_of(const Scene& scene, const std::string& folder_name) {
   const std::filesystem::path folder(folder_name);
   std::ifstream summary(folder / "summary.json"), stored(folder / "scene.json");
   if (!summary.good() || !stored.good()) return false;
-  // The worker threads are left out of the comparison: every kernel is a gather (solver/parallel.h), so a run's
+  // The worker threads are left out of the comparison: every kernel is a gather (core/parallel.h), so a run's
   // results do not depend on them (a test runs the same scene on one and two threads and compares the histories).
   auto without_threads = [](json scene_json) {
     if (scene_json.contains("solver") && scene_json["solver"].is_object()) scene_json["solver"].erase("threads");

@@ -313,7 +313,7 @@ TEST_CASE("needle run --groove-start-mm: the scene says so, the built needle's g
 
 TEST_CASE("needle run --contact-skin-mm, --contact-stiffness-factor: the scene says so, the solver feels both, bad input is refused",
           "[apps][lspg][gmsh][contact]") {
-  // The penalty contact's two numerical parameters (solver/needle_tissue_contact.h). The skin holds the particles off the
+  // The penalty contact's two numerical parameters (solver/contact/needle_tissue_contact.h). The skin holds the particles off the
   // needle's true surface: at stiffness factor 10, without it they sink into the rod until the penalty holds them, with a
   // thin one less, with a thick one (0.04 mm, the default before the skin study) hardly at all (the rod pushed 0.8 mm in).
   // The tissue's step is capped by the contact's own stable step, which goes as 1 / sqrt(k): the default's three times

@@ -187,7 +187,7 @@ TEST_CASE("needle run: a rod pushed into a small tissue block writes the coupled
 }
 
 TEST_CASE("needle run: the worker threads do not change a run, bit for bit", "[apps][lspg][gmsh][threads]") {
-  // Every per-particle kernel is a gather (solver/parallel.h): each index writes only its own outputs, so the
+  // Every per-particle kernel is a gather (core/parallel.h): each index writes only its own outputs, so the
   // schedule cannot change a sum's order. The same coupled run on one and on two threads must give the same
   // history, every column of every row, exactly; `paper` and `calibrate` reuse runs across thread counts on this.
   const RunFiles one = run_rod_into_small_block("threads_1", "--threads 1");

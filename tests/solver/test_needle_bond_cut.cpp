@@ -1,4 +1,4 @@
-// The needle cuts the bonds its body passes through (solver/needle_bond_cut.h): segment crossings of a
+// The needle cuts the bonds its body passes through (solver/separation/needle_bond_cut.h): segment crossings of a
 // meshed rod against the cylinder's closed form, on the full and on the half model, and the bonds of a
 // particle lattice the rod lies in against an independent point-sampling of the cylinder.
 #include <catch2/catch.hpp>

@@ -1,4 +1,4 @@
-// The slit in the symmetry plane (solver/symmetry_slit.h): which particles it opens, and what an opened
+// The slit in the symmetry plane (solver/separation/symmetry_slit.h): which particles it opens, and what an opened
 // plane does in the dynamics: it holds z >= 0 against a block pressed onto it, and lets go of a block
 // pulled off it, which then flies free as Newton's second law says.
 #include <catch2/catch.hpp>

@@ -1,4 +1,4 @@
-// The crack the tip drives past the rod's outline (solver/tip_crack.h): which bonds its fins cut, against
+// The crack the tip drives past the rod's outline (solver/separation/tip_crack.h): which bonds its fins cut, against
 // counts that follow from a lattice's layout, and single bonds placed on either side of the fin's edges.
 #include <catch2/catch.hpp>
 #include <algorithm>
