@@ -270,8 +270,6 @@ class InsertionRunModel : public RunModel {
     summary["max_particles_inside"] = run_->max_particles_inside();
     summary["particles"] = particles_.num_particles();
     summary["bonds_broken"] = run_->bonds_broken();
-    summary["cutting"] = {{"pressure_MPa", scene_.tissue.contact.cutting_pressure_MPa}, {"work_mJ", run_->contact_model().cutting_work_mJ()},
-                          {"force_at_end_N", run_->contact().cutting_force_N}};
     summary["groove"] = {{"groove_fill", groove.groove_fill},
                          {"floor_contact_fraction", groove.floor_contact_fraction},
                          {"mean_gap_mm", groove.mean_gap_mm},
@@ -281,6 +279,7 @@ class InsertionRunModel : public RunModel {
                                         "(tissue's lowest edge to the rod's top over floor to top), in the needle's own frame"}};
     summary["mesh"] = {{"order", needle_->mesh().order}, {"elements", needle_->num_elements()}, {"nodes", needle_->num_nodes()}};
     needle_model_->add_summary(summary);
+    run_->contact_model().add_summary(summary);
     for (const auto& separation : run_->separations()) separation->add_summary(summary, run_->tissue());
   }
   std::string log_steps(double solve_s) const override {

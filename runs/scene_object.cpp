@@ -6,42 +6,9 @@
 #include <vector>
 
 #include "core/input_error.h"
+#include "core/units.h"
 
 namespace needle {
-namespace {
-
-struct UnitSpec {
-  const char* name;
-  Dimension dimension;
-  double to_internal;
-};
-
-// Units a value string may carry; internal units are mm, ms, mm/ms (= m/s), MPa, g/mm^3, deg.
-const std::vector<UnitSpec>& units() {
-  static const std::vector<UnitSpec> table = {
-      {"mm", Dimension::length, 1.0},       {"cm", Dimension::length, 10.0},      {"m", Dimension::length, 1000.0},
-      {"um", Dimension::length, 1e-3},      {"ms", Dimension::time, 1.0},         {"s", Dimension::time, 1000.0},
-      {"us", Dimension::time, 1e-3},        {"m/s", Dimension::speed, 1.0},       {"mm/ms", Dimension::speed, 1.0},
-      {"mm/s", Dimension::speed, 1e-3},     {"MPa", Dimension::stress, 1.0},      {"GPa", Dimension::stress, 1000.0},
-      {"kPa", Dimension::stress, 1e-3},     {"Pa", Dimension::stress, 1e-6},      {"g/cm3", Dimension::density, 1e-3},
-      {"kg/m3", Dimension::density, 1e-6},  {"g/mm3", Dimension::density, 1.0},   {"deg", Dimension::angle, 1.0},
-      {"rad", Dimension::angle, 180.0 / M_PI}};
-  return table;
-}
-
-const char* dimension_name(Dimension d) {
-  switch (d) {
-    case Dimension::length: return "a length (mm, cm, m, um)";
-    case Dimension::time: return "a time (ms, s, us)";
-    case Dimension::speed: return "a speed (m/s, mm/ms, mm/s)";
-    case Dimension::stress: return "a stress (MPa, GPa, kPa, Pa)";
-    case Dimension::density: return "a density (g/cm3, kg/m3, g/mm3)";
-    case Dimension::angle: return "an angle (deg, rad)";
-  }
-  return "";
-}
-
-}  // namespace
 
 ValueCheck positive() {
   return [](double v) { return v > 0 ? "" : "must be positive"; };
@@ -56,19 +23,6 @@ ValueCheck any_finite() {
   return [](double) { return ""; };
 }
 
-std::string canonical_suffix(Dimension d) {
-  switch (d) {
-    case Dimension::length: return "_mm";
-    case Dimension::time: return "_ms";
-    case Dimension::speed: return "_m_per_s";
-    case Dimension::stress: return "_MPa";
-    case Dimension::density: return "_g_per_cm3";
-    case Dimension::angle: return "_deg";
-  }
-  return "";
-}
-
-double canonical_to_internal(Dimension d) { return d == Dimension::density ? 1e-3 : 1.0; }
 
 SceneObject::SceneObject(const JsonDocument& doc, std::string pointer, std::string name)
     : doc_(doc), object_(pointer.empty() ? doc.value : doc.value.at(nlohmann::json::json_pointer(pointer))),
@@ -146,14 +100,13 @@ double SceneObject::quantity(const std::string& base, Dimension dimension, doubl
   in >> unit >> rest;
   NEEDLE_REQUIRE(!unit.empty() && rest.empty(), fmt::format("{}: write a number and one unit, like \"3 mm\" (got '{}')", where(base),
                                                             v.get<std::string>()));
-  for (const UnitSpec& u : units())
-    if (u.name == unit) {
-      NEEDLE_REQUIRE(u.dimension == dimension, fmt::format("{}: '{}' is not {}", where(base), unit, dimension_name(dimension)));
-      const double value = magnitude * u.to_internal;
-      const std::string problem = std::isfinite(value) ? check(value) : "must be finite";
-      NEEDLE_REQUIRE(problem.empty(), fmt::format("{} {} (got {})", where(base), problem, v.get<std::string>()));
-      return value;
-    }
+  if (const UnitSpec* u = find_unit(unit)) {
+    NEEDLE_REQUIRE(u->dimension == dimension, fmt::format("{}: '{}' is not {}", where(base), unit, dimension_name(dimension)));
+    const double value = magnitude * u->to_internal;
+    const std::string problem = std::isfinite(value) ? check(value) : "must be finite";
+    NEEDLE_REQUIRE(problem.empty(), fmt::format("{} {} (got {})", where(base), problem, v.get<std::string>()));
+    return value;
+  }
   throw InputError(fmt::format("{}: unknown unit '{}'; {} is expected", where(base), unit, dimension_name(dimension)));
 }
 

@@ -8,11 +8,10 @@
 #include <string>
 #include <vector>
 
+#include "core/units.h"
 #include "runs/json_lines.h"
 
 namespace needle {
-
-enum class Dimension { length, time, speed, stress, density, angle };
 
 // Checks a value (internal units); returns an empty string if fine, else what is wrong.
 using ValueCheck = std::function<std::string(double)>;
@@ -47,9 +46,5 @@ class SceneObject {
   std::string pointer_, name_;
   std::set<std::string> used_;
 };
-
-// The canonical key suffix of a dimension ("_mm") and the factor from its unit to internal units.
-std::string canonical_suffix(Dimension dimension);
-double canonical_to_internal(Dimension dimension);
 
 }  // namespace needle

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+#include <nlohmann/json.hpp>
 
 #include "core/input_error.h"
 #include "core/parallel.h"
@@ -388,6 +389,10 @@ std::vector<Eigen::Vector3d> NeedleTissueContact::pull_back(const std::vector<Ve
     }
   });
   return out;
+}
+
+void NeedleTissueContact::add_summary(nlohmann::json& summary) const {
+  summary["cutting"] = {{"pressure_MPa", options_.cutting_pressure_MPa}, {"work_mJ", cutting_work_mJ_}, {"force_at_end_N", report_.cutting_force_N}};
 }
 
 }  // namespace needle

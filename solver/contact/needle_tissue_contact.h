@@ -47,6 +47,7 @@
 // it evaluates the penalty half a step late for them, which pumps energy in: tried and rejected.)
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
+#include <nlohmann/json_fwd.hpp>
 #include <limits>
 #include <string>
 #include <utility>
@@ -143,6 +144,8 @@ class NeedleTissueContact : public NeedleLoads {
   std::vector<Eigen::Vector3d> pull_back(const std::vector<Vec3d>& x, const Eigen::MatrixX3d& needle_x);
   const ContactSurface& surface() const { return surface_; }
   const ContactOptions& options() const { return options_; }
+  // The contact's own entries in a run's summary.json: "cutting" (the pressure, its work, its force at the end).
+  void add_summary(nlohmann::json& summary) const;
 
  private:
   // A particle that may touch the needle during the step, with the geometry found at the step's start.
