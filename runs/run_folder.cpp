@@ -19,17 +19,39 @@ std::string clock_text(double seconds) {
   return s >= 3600 ? fmt::format("{}:{:02}:{:02}", s / 3600, s / 60 % 60, s % 60) : fmt::format("{}:{:02}", s / 60, s % 60);
 }
 
+constexpr const char* kMarker = ".needle-run";  // in every run folder: the toolkit wrote it, --overwrite may replace it
+
+// Whether folder is a run folder the toolkit wrote: its marker, or (folders from before the marker) its
+// summary.json and scene.json.
+bool holds_run(const std::filesystem::path& folder) {
+  namespace fs = std::filesystem;
+  return fs::is_directory(folder) && (fs::exists(folder / kMarker) || (fs::exists(folder / "summary.json") && fs::exists(folder / "scene.json")));
+}
+
 }  // namespace
 
 RunFolder::RunFolder(const std::string& dir, bool overwrite) : final_(dir), overwrite_(overwrite) {
+  namespace fs = std::filesystem;
   NEEDLE_REQUIRE(!dir.empty(), "--out needs a folder");
-  std::filesystem::path parent = std::filesystem::absolute(final_).parent_path();
-  NEEDLE_REQUIRE(std::filesystem::is_directory(parent), fmt::format("the folder '{}' that should hold '{}' does not exist", parent.string(), dir));
-  NEEDLE_REQUIRE(overwrite || !std::filesystem::exists(final_),
-                 fmt::format("'{}' already exists; choose another --out or pass --overwrite", dir));
-  partial_ = parent / ("." + final_.filename().string() + ".partial");
-  std::filesystem::remove_all(partial_);
-  std::filesystem::create_directories(partial_);
+  const fs::path target = fs::weakly_canonical(fs::absolute(final_));
+  // "." and ".." name the folder itself: its parent is the one above.
+  const fs::path parent = target.has_parent_path() && target != target.root_path() ? target.parent_path() : target;
+  NEEDLE_REQUIRE(fs::is_directory(parent), fmt::format("the folder '{}' that should hold '{}' does not exist", parent.string(), dir));
+  if (fs::exists(final_)) {
+    NEEDLE_REQUIRE(overwrite, fmt::format("'{}' already exists; choose another --out or pass --overwrite", dir));
+    // --overwrite replaces a run the toolkit wrote, and nothing else: never the current folder or one above it.
+    const fs::path cwd = fs::weakly_canonical(fs::current_path());
+    const auto [end, unused] = std::mismatch(target.begin(), target.end(), cwd.begin(), cwd.end());
+    NEEDLE_REQUIRE(end != target.end() && target != target.root_path(),
+                   fmt::format("--overwrite would replace '{}', which holds the current folder; choose another --out", dir));
+    NEEDLE_REQUIRE(holds_run(final_), fmt::format("--overwrite replaces only a run folder this toolkit wrote (with its {} marker, or its "
+                                                  "summary.json and scene.json); '{}' is not one, and is left as it is",
+                                                  kMarker, dir));
+  }
+  partial_ = parent / ("." + target.filename().string() + ".partial");
+  fs::remove_all(partial_);
+  fs::create_directories(partial_);
+  std::ofstream(partial_ / kMarker) << "A run folder written by needle (docs/scenes.md); --overwrite may replace it.\n";
 }
 
 RunFolder::~RunFolder() {

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <cstdlib>
 #include <sstream>
 
 #include "runs/csv_table.h"
@@ -246,3 +247,44 @@ TEST_CASE("needle run: no needle, two needles or a bad number exit 2 with one li
   }
 }
 
+
+TEST_CASE("--overwrite replaces only a run folder the toolkit wrote, never the current folder or one above it", "[apps][sim][gmsh]") {
+  // A needle-alone scene of a fraction of a second.
+  const fs::path dir = fresh_folder("overwrite_guard");
+  write(dir / "scene.json", R"({"needle": {"plain_rod": true, "length_mm": 6, "mesh": {"order": 1, "size_mm": 0.5}},)"
+                            R"("motion": {"accel_time_ms": 0.02, "travel_mm": 0.1}, "cannula": {"enabled": false}, "output": {"frames": 0}})");
+  const std::string scene = (dir / "scene.json").string();
+  // A folder of the user's: refused, and left as it was.
+  fs::create_directories(dir / "mine");
+  write(dir / "mine" / "notes.txt", "keep me");
+  const auto mine = run("simulate " + scene + " --out " + (dir / "mine").string() + " --overwrite --quiet", true);
+  INFO(mine.out);
+  CHECK(mine.exit_code == 2);
+  CHECK(mine.out.find("--overwrite replaces only a run folder this toolkit wrote") != std::string::npos);
+  CHECK(fs::exists(dir / "mine" / "notes.txt"));
+  // The current folder and the one above it: refused, whatever they hold. Run from a folder inside the test's own,
+  // so that a guard that failed would empty only that.
+  fs::create_directories(dir / "inner");
+  write(dir / "inner" / "keep.txt", "keep me");
+  for (const std::string& out : std::vector<std::string>{".", "..", "../inner", (dir / "inner").string()}) {
+    const std::string command = "cd " + (dir / "inner").string() + " && " + NEEDLE_BINARY + " simulate " + scene + " --out " + out +
+                                " --overwrite --quiet > " + (dir / "out.txt").string() + " 2>&1";
+    const int status = std::system(command.c_str());
+    std::ifstream text(dir / "out.txt");
+    const std::string message((std::istreambuf_iterator<char>(text)), std::istreambuf_iterator<char>());
+    INFO(out << ": " << message);
+    CHECK(WEXITSTATUS(status) == 2);
+    CHECK(message.find("--overwrite would replace") != std::string::npos);
+    CHECK(fs::exists(dir / "inner" / "keep.txt"));
+  }
+  CHECK(fs::exists(dir / "scene.json"));
+  CHECK(fs::exists(dir / "mine" / "notes.txt"));
+  // A run folder: replaced, and marked as the toolkit's.
+  const auto first = run("simulate " + scene + " --out " + (dir / "run").string() + " --quiet", true);
+  REQUIRE(first.exit_code == 0);
+  CHECK(fs::exists(dir / "run" / ".needle-run"));
+  const auto again = run("simulate " + scene + " --out " + (dir / "run").string() + " --overwrite --quiet", true);
+  INFO(again.out);
+  CHECK(again.exit_code == 0);
+  CHECK(fs::exists(dir / "run" / "summary.json"));
+}
