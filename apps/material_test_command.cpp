@@ -131,7 +131,7 @@ void add_material_test_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("material-test",
                                      "Pull a particle specimen of the tissue card in uniaxial tension; compare with the closed-form curve");
   cmd->add_option("--material", o->material_file, "Tissue card as JSON (see data/materials/); flags below override it")->check(CLI::ExistingFile);
-  cmd->add_option("--E-MPa", o->E_MPa, "Young's modulus (default 0.665, see docs/solver.md)");
+  cmd->add_option("--E-MPa,--tissue-E-MPa", o->E_MPa, "The tissue's Young's modulus (default 0.665, see docs/solver.md; --tissue-E-MPa as in run)");
   cmd->add_option("--k-MPa", o->k_MPa, "Power-law strength coefficient k (default 0.35)");
   cmd->add_option("--n", o->n, "Power-law hardening exponent n > 1 (default 2.75)");
   cmd->add_option("--nu", o->nu, "Poisson's ratio (default 0.45)");

@@ -149,7 +149,7 @@ void add_mesh_command(CLI::App& app) {
   cmd->add_option("--route", o->route, "exact: rebuild the ideal solid in OpenCASCADE (curved T10 shaft); surface: fill the CAD triangles")
       ->capture_default_str();
   cmd->add_option("--order", o->mesh.order, "1: 4-node tets, 2: 10-node tets")->capture_default_str();
-  cmd->add_option("--size-mm", o->mesh.size_mm, "Target edge length over the tip and the groove")->capture_default_str();
+  cmd->add_option("--size-mm,--mesh-size-mm", o->mesh.size_mm, "Target edge length over the tip and the groove (--mesh-size-mm as in run)")->capture_default_str();
   cmd->add_option("--tip-size-mm", o->mesh.tip_size_mm, "Edge length at tip point A (default size/2)");
   cmd->add_option("--edge-size-mm", o->mesh.edge_size_mm, "Edge length along sharp facet and groove edges (default size/2)");
   cmd->add_option("--shaft-size-mm", o->mesh.shaft_size_mm, "Edge length along the shaft behind the groove (default 2 x size)");

@@ -135,9 +135,9 @@ void add_stiffness_command(CLI::App& app) {
   c->add_option("--rod-diameter-mm", o->rod_diameter_mm, "Diameter of the plain rod")->capture_default_str();
   c->add_option("--free-length-mm", o->free_length_mm, "Distance from tip point A back to the clamp")->capture_default_str();
   c->add_option("--order", o->mesh.order, "Element order: 1 (T4) or 2 (T10)")->capture_default_str();
-  c->add_option("--size-mm", o->mesh.size_mm, "Element size over the tip and groove")->capture_default_str();
+  c->add_option("--size-mm,--mesh-size-mm", o->mesh.size_mm, "Element size over the tip and groove (--mesh-size-mm as in run)")->capture_default_str();
   c->add_option("--shaft-size-mm", o->mesh.shaft_size_mm, "Element size along the plain shaft (default 2 x size)");
-  c->add_option("--E-MPa", o->material.youngs_modulus_MPa, "Young's modulus of the needle")->capture_default_str();
+  c->add_option("--E-MPa,--needle-E-MPa", o->material.youngs_modulus_MPa, "Young's modulus of the needle")->capture_default_str();
   c->add_option("--nu", o->material.poisson_ratio, "Poisson's ratio of the needle")->capture_default_str();
   c->add_option("--density-g-per-cm3", o->density_g_per_cm3, "Density of the needle")->capture_default_str();
   c->add_option("--modes", o->modes, "Number of vibration modes to compute")->capture_default_str();
