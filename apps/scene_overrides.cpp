@@ -63,7 +63,7 @@ void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
     if (!std::isnan(o.relaxation_time_ms)) scene.tissue.material.relaxation_time_ms = o.relaxation_time_ms;
     scene.tissue.material.validate();
   }
-  if (given_or_zero(o.cutting_pressure_MPa, "--cutting-pressure-mpa")) scene.tissue.contact.cutting_pressure_MPa = o.cutting_pressure_MPa;
+  if (given_or_zero(o.cutting_pressure_MPa, "--cutting-pressure-mpa")) scene.tissue.cutting.pressure_MPa = o.cutting_pressure_MPa;
   if (given_or_zero(o.crack_reach_mm, "--crack-reach-mm")) scene.tissue.separation.crack.reach_mm = o.crack_reach_mm;
   if (!o.crack_angles_deg.empty()) {
     NEEDLE_REQUIRE(std::all_of(o.crack_angles_deg.begin(), o.crack_angles_deg.end(), [](double a) { return std::isfinite(a) && a >= -180 && a <= 180; }),

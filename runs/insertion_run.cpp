@@ -208,10 +208,10 @@ class InsertionRunModel : public RunModel {
     surface_ = std::make_unique<ContactSurface>(needle_->mesh(), surface_options);
     particles_ = scene_particles(scene);
     tissue_ = std::make_unique<SpgTissue>(particles_, scene.tissue.material, scene.tissue.spg);
-    ContactOptions contact = scene.tissue.contact;
-    contact.cutting_facets = built_.tip_facets;
+    CuttingOptions cutting = scene.tissue.cutting;
+    cutting.facets = built_.tip_facets;
     const bool ground_tip = !built_.tip_facets.empty();  // a plain rod's end is cut square; a mesh file names no facets
-    NEEDLE_REQUIRE(contact.cutting_pressure_MPa == 0 || ground_tip,
+    NEEDLE_REQUIRE(!cutting.enabled() || ground_tip,
                    "a cutting pressure needs a needle with tip facets: a ground tip from a preset, d_a or a recipe (not a plain rod or a mesh file)");
     NEEDLE_REQUIRE(!scene.tissue.separation.crack.enabled() || ground_tip,
                    "a crack from the tip point needs a needle with a ground tip point: a preset, d_a or a recipe (not a plain rod or a mesh file)");
@@ -220,7 +220,8 @@ class InsertionRunModel : public RunModel {
     needle_model_ = make_needle_model(scene.needle.model, {*needle_, driven_base_supports(needle_->mesh(), scene.motion, scene.direction),
                                                            scene.cannula.enabled ? std::optional<CannulaOptions>(scene.cannula) : std::nullopt,
                                                            scene_dynamics_options(scene)});
-    run_ = std::make_unique<CoupledInsertion>(*needle_model_, *tissue_, *surface_, contact, std::move(separations), scene.solver.coupling);
+    run_ = std::make_unique<CoupledInsertion>(*needle_model_, *tissue_, *surface_, scene.tissue.contact, std::move(separations),
+                                              scene.solver.coupling, cutting);
     tip_ = nearest_node(needle_->mesh(), built_.tip_point);
   }
 
@@ -279,7 +280,7 @@ class InsertionRunModel : public RunModel {
                                         "(tissue's lowest edge to the rod's top over floor to top), in the needle's own frame"}};
     summary["mesh"] = {{"order", needle_->mesh().order}, {"elements", needle_->num_elements()}, {"nodes", needle_->num_nodes()}};
     needle_model_->add_summary(summary);
-    run_->contact_model().add_summary(summary);
+    if (run_->cutting()) run_->cutting()->add_summary(summary);
     for (const auto& separation : run_->separations()) separation->add_summary(summary, run_->tissue());
   }
   std::string log_steps(double solve_s) const override {

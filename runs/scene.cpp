@@ -147,7 +147,7 @@ void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc) {
     t.separation.needle_cut = c.boolean("cuts_bonds", t.separation.needle_cut);
     t.separation.slit.half_height_mm = c.quantity("slit_half_height", Dimension::length, t.separation.slit.half_height_mm, non_negative());
     t.separation.slit.lead_mm = c.quantity("slit_lead", Dimension::length, t.separation.slit.lead_mm, non_negative());
-    t.contact.cutting_pressure_MPa = c.quantity("cutting_pressure", Dimension::stress, t.contact.cutting_pressure_MPa, non_negative());
+    t.cutting.pressure_MPa = c.quantity("cutting_pressure", Dimension::stress, t.cutting.pressure_MPa, non_negative());
     t.separation.crack.reach_mm = c.quantity("crack_reach", Dimension::length, t.separation.crack.reach_mm, non_negative());
     t.separation.crack.angles_deg = c.numbers("crack_angles_deg", t.separation.crack.angles_deg, within(-180.0, 180.0));
     t.separation.crack.lead_mm = c.quantity("crack_lead", Dimension::length, t.separation.crack.lead_mm, non_negative());
@@ -243,7 +243,7 @@ json scene_to_json(const Scene& s) {
     tissue["contact"]["slit_half_height_mm"] = t.separation.slit.half_height_mm;
     tissue["contact"]["slit_lead_mm"] = t.separation.slit.lead_mm;
   }
-  if (t.contact.cutting_pressure_MPa > 0) tissue["contact"]["cutting_pressure_MPa"] = t.contact.cutting_pressure_MPa;
+  if (t.cutting.pressure_MPa > 0) tissue["contact"]["cutting_pressure_MPa"] = t.cutting.pressure_MPa;
   if (t.separation.crack.enabled()) {
     tissue["contact"]["crack_reach_mm"] = t.separation.crack.reach_mm;
     tissue["contact"]["crack_angles_deg"] = t.separation.crack.angles_deg;

@@ -49,6 +49,7 @@ struct TissueScene {
   SpgOptions spg;                           // kernel, stabilization, bond failure, cfl (docs/solver.md)
   ContactOptions contact;                   // friction copied from `friction`
   SeparationOptions separation;             // the needle's cut, slit and crack (keys in the contact section)
+  CuttingOptions cutting;                   // the cost of cutting on the tip facets (key cutting_pressure_MPa in the contact section)
 };
 
 struct SolverScene {

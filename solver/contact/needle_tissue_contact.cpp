@@ -4,7 +4,6 @@
 #include <cmath>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
-#include <nlohmann/json.hpp>
 
 #include "core/input_error.h"
 #include "core/parallel.h"
@@ -22,8 +21,6 @@ void ContactOptions::validate(const std::string& where) const {
                  fmt::format("{}: needle_stiffness_scale must be in (0, 0.5] (got {})", where, needle_stiffness_scale));
   NEEDLE_REQUIRE(std::isfinite(voxel_mm) && voxel_mm >= 1e-3 && voxel_mm <= 0.2,
                  fmt::format("{}: voxel_mm must be in [0.001, 0.2] (got {})", where, voxel_mm));
-  NEEDLE_REQUIRE(std::isfinite(cutting_pressure_MPa) && cutting_pressure_MPa >= 0,
-                 fmt::format("{}: cutting_pressure_MPa must be zero or positive (got {})", where, cutting_pressure_MPa));
 }
 
 NeedleTissueContact::NeedleTissueContact(const ContactSurface& surface, const TissueParticles& particles,
@@ -43,31 +40,6 @@ NeedleTissueContact::NeedleTissueContact(const ContactSurface& surface, const Ti
     stable_dt_ms_ = std::min(stable_dt_ms_, 2 * std::sqrt(mass_[i] / stiffness_[i]));
   }
   node_cell_mm_ = surface_.node_search_radius_mm();
-  if (options_.cutting_pressure_MPa > 0) {
-    // The tip's ground facets all face forward (their outward normals have n_x = sin(theta) > 0 in the CAD
-    // frame), which orients each triangle whatever its winding.
-    const std::vector<std::string>& tip_facets = options_.cutting_facets;
-    const Eigen::MatrixX3d& X = surface_.reference_positions();
-    const Eigen::MatrixX3i& tri = surface_.triangles();
-    cutting_orientation_.assign(static_cast<size_t>(surface_.num_triangles()), 0.0);
-    double half_spacing = 0;
-    for (size_t i = 0; i < n; ++i) {
-      cutting_block_.extend(particles.position_mm[i]);
-      half_spacing = std::max(half_spacing, 0.5 * particles.spacing_mm[i]);
-    }
-    cutting_block_.min().array() -= half_spacing;
-    cutting_block_.max().array() += half_spacing;
-    for (int t = 0; t < surface_.num_triangles(); ++t) {
-      const std::string& tag = surface_.tag_names()[static_cast<size_t>(surface_.triangle_tag(t))];
-      if (std::find(tip_facets.begin(), tip_facets.end(), tag) == tip_facets.end()) continue;
-      const Eigen::Vector3d a = X.row(tri(t, 0)), b = X.row(tri(t, 1)), c = X.row(tri(t, 2));
-      cutting_orientation_[static_cast<size_t>(t)] = (b - a).cross(c - a).x() >= 0 ? 1.0 : -1.0;
-      cutting_triangles_.push_back(t);
-    }
-    NEEDLE_REQUIRE(!cutting_triangles_.empty(),
-                   fmt::format("contact: a cutting pressure needs a needle with tip facets; the surface has none of the tags {}",
-                               fmt::join(tip_facets, ", ")));
-  }
 }
 
 void NeedleTissueContact::set_needle(const Eigen::VectorXd& nodal_mass_g, double time_step_ms) {
@@ -293,12 +265,6 @@ void NeedleTissueContact::needle_forces(const Eigen::MatrixX3d& needle_x, const 
     report_.force_on_needle_N -= f;
   }
   report_.cutting_force_N = 0;
-  if (!cutting_triangles_.empty()) {
-    const double cutting_power = add_cutting_resistance(needle_x, needle_v, out);
-    if (dt > 0) cutting_work_mJ_ += 0.5 * dt * (last_cutting_power_mW_ + cutting_power);
-    last_cutting_power_mW_ = cutting_power;
-    friction_power += cutting_power;
-  }
   report_.friction_power_mW = friction_power;
   if (dt > 0) friction_dissipation_mJ_ += 0.5 * dt * (last_friction_power_mW_ + friction_power);
   if (tau == 0) {  // the state at a step's start (t = 0, before any step): the particles get the forces as they are
@@ -313,31 +279,6 @@ void NeedleTissueContact::needle_forces(const Eigen::MatrixX3d& needle_x, const 
   }
   last_friction_power_mW_ = friction_power;
   last_eval_ms_ = time_ms;
-}
-
-double NeedleTissueContact::add_cutting_resistance(const Eigen::MatrixX3d& needle_x, const Eigen::MatrixX3d& needle_v,
-                                                   std::vector<std::pair<int, Eigen::Vector3d>>& out) {
-  const Eigen::MatrixX3i& tri = surface_.triangles();
-  const double pressure = options_.cutting_pressure_MPa;
-  double power = 0;
-  for (int t : cutting_triangles_) {
-    const Eigen::Vector3d a = needle_x.row(tri(t, 0)), b = needle_x.row(tri(t, 1)), c = needle_x.row(tri(t, 2));
-    if (!cutting_block_.contains((a + b + c) / 3.0)) continue;
-    const Eigen::Vector3d area_normal = 0.5 * cutting_orientation_[static_cast<size_t>(t)] * (b - a).cross(c - a);  // A n
-    const Eigen::Vector3d v = (needle_v.row(tri(t, 0)) + needle_v.row(tri(t, 1)) + needle_v.row(tri(t, 2))).transpose() / 3.0;
-    const double advance = area_normal.dot(v);  // A n . v
-    if (!(advance > 0)) continue;               // only where the facet moves into the tissue
-    const Eigen::Vector3d f = -pressure * area_normal;
-    for (int k = 0; k < 3; ++k) out.emplace_back(tri(t, k), f / 3.0);
-    FacetContact& facet = report_.facets[static_cast<size_t>(surface_.triangle_tag(t))];
-    facet.normal_N += pressure * area_normal.norm();
-    facet.force_N += f;
-    facet.cutting_force_N += f;
-    report_.force_on_needle_N += f;
-    report_.cutting_force_N += pressure * area_normal.norm();
-    power += pressure * advance;
-  }
-  return power;
 }
 
 void NeedleTissueContact::end_step(std::vector<Vec3d>& particle_force) {
@@ -391,8 +332,5 @@ std::vector<Eigen::Vector3d> NeedleTissueContact::pull_back(const std::vector<Ve
   return out;
 }
 
-void NeedleTissueContact::add_summary(nlohmann::json& summary) const {
-  summary["cutting"] = {{"pressure_MPa", options_.cutting_pressure_MPa}, {"work_mJ", cutting_work_mJ_}, {"force_at_end_N", report_.cutting_force_N}};
-}
 
 }  // namespace needle

@@ -19,19 +19,9 @@
 // The particle gets f = f_n + f_t; the needle gets -f on the three nodes of that triangle by
 // barycentric weights. Forces are booked per facet tag (top, bottom, sides, lancets, groove floor ...).
 //
-// Cutting resistance (cutting_pressure_MPa = p_c > 0, off by default): separating the tissue at the tip
-// costs work (its fracture energy), which the penalty above never asks for: the needle's cut
-// (needle_bond_cut.h) breaks bonds for free. Every triangle of a tip facet (the surface tags listed in
-// cutting_facets: the tip's ground facets, which the caller takes from the tip geometry) whose centroid lies in the tissue block (the box of the particles at the start, grown by half
-// a spacing) and that advances into it (outward normal n, n . v > 0) is loaded with -p_c A n, a third on
-// each corner. (The block, not the particles in contact: particles coarser than the facet's triangles
-// touch only some of them.) It does the work p_c A n . v per unit time, booked as dissipation
-// (with friction). Per millimetre of advance the needle then pays p_c times the tip's frontal area in
-// contact: a fracture energy G_c = p_c A_frontal / w for a cut of width w. The reaction goes to the crack
-// front, which the particles do not resolve; it is left out of the tissue (its momentum is the needle's
-// drive's). The facets' normals set how the resistance bends the needle, as the paper's tip forces do.
+// The cost of cutting is a needle load of its own (cutting_resistance.h), not part of this law.
 //
-// Multi-rate integration over one tissue step [t, t + Dt] (lspg_insertion.h):
+// Multi-rate integration over one tissue step [t, t + Dt] (insertion/coupled_insertion.h):
 //   begin_step: the particles move on straight lines over the step (velocity Verlet's drift), so their
 //     path is known. The geometry (triangle, weights, normal, phi) is found once, at t, for every particle
 //     that can reach the surface within the step;
@@ -47,7 +37,6 @@
 // it evaluates the penalty half a step late for them, which pumps energy in: tried and rejected.)
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
-#include <nlohmann/json_fwd.hpp>
 #include <limits>
 #include <string>
 #include <utility>
@@ -68,10 +57,6 @@ struct ContactOptions {
   double damping_ratio = 0.2;     // normal viscous damping, fraction of critical 2 sqrt(k m_r) (LS-DYNA's VDC)
   double needle_stiffness_scale = 0.1;  // cap of k on the needle's side, x m_c / dt_needle^2
   double voxel_mm = 0.02;         // the needle level set's resolution
-  // Cutting resistance (MPa): the work of separating the tissue at the tip, as a pressure on the tip's
-  // facets (see below). 0: cutting costs nothing, the paper's model and the default.
-  double cutting_pressure_MPa = 0.0;
-  std::vector<std::string> cutting_facets;  // the surface tags it loads: the tip's ground facets (not a scene key)
   void validate(const std::string& where = "contact") const;  // InputError naming the bad field
 };
 
@@ -123,10 +108,8 @@ class NeedleTissueContact : public NeedleLoads {
   // The state of the last force evaluation (in contact, forces per facet, energy) and of the last
   // begin_step (particles inside).
   const ContactReport& report() const { return report_; }
-  // Energy dissipated by friction, normal damping and the cutting resistance since the start.
+  // Energy dissipated by friction and normal damping since the start.
   double friction_dissipation_mJ() const { return friction_dissipation_mJ_; }
-  // The cutting resistance's share of it.
-  double cutting_work_mJ() const { return cutting_work_mJ_; }
   // Sum of the penalty energy's jumps where each step finds the geometry anew (the gap is linearised
   // within a step): energy the contact's discretisation adds (> 0) or removes. A diagnostic.
   double relinearisation_energy_mJ() const { return relinearisation_energy_mJ_; }
@@ -144,8 +127,6 @@ class NeedleTissueContact : public NeedleLoads {
   std::vector<Eigen::Vector3d> pull_back(const std::vector<Vec3d>& x, const Eigen::MatrixX3d& needle_x);
   const ContactSurface& surface() const { return surface_; }
   const ContactOptions& options() const { return options_; }
-  // The contact's own entries in a run's summary.json: "cutting" (the pressure, its work, its force at the end).
-  void add_summary(nlohmann::json& summary) const;
 
  private:
   // A particle that may touch the needle during the step, with the geometry found at the step's start.
@@ -169,9 +150,6 @@ class NeedleTissueContact : public NeedleLoads {
   void probe(const std::vector<Vec3d>& x, const Eigen::MatrixX3d& needle_x, const std::vector<double>& reach);
   Eigen::Vector3d surface_point(const Pair& pair, const Eigen::MatrixX3d& needle) const;
   void record_contacts();  // contacts_ from the last evaluation (at a step's end, not at every substep)
-  // The cutting resistance on the tip facets' triangles in the tissue block; returns its power (mW).
-  double add_cutting_resistance(const Eigen::MatrixX3d& needle_x, const Eigen::MatrixX3d& needle_v,
-                                std::vector<std::pair<int, Eigen::Vector3d>>& force_N);
 
   const ContactSurface& surface_;
   ContactOptions options_;
@@ -188,10 +166,6 @@ class NeedleTissueContact : public NeedleLoads {
   std::vector<int> previous_particles_;                       // ... and their particles
   std::vector<std::pair<int, int>> contacts_;                 // (particle, triangle) in contact at the last step's end
   double step_start_ms_ = 0, step_dt_ms_ = 0, last_eval_ms_ = 0, last_friction_power_mW_ = 0, friction_dissipation_mJ_ = 0, relinearisation_energy_mJ_ = 0;
-  double last_cutting_power_mW_ = 0, cutting_work_mJ_ = 0;
-  std::vector<int> cutting_triangles_;           // the tip facets' triangles (only with a cutting pressure)
-  std::vector<double> cutting_orientation_;      // +1 or -1 per triangle of the surface: turns its winding's normal outward (forward)
-  Eigen::AlignedBox3d cutting_block_;            // the tissue block the tip cuts (particles at the start, grown by half a spacing)
   ContactReport report_;
   // Grid of the current surface nodes (rebuilt per query): sorted (cell, node).
   double node_cell_mm_ = 0;

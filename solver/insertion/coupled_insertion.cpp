@@ -18,13 +18,17 @@ void CouplingOptions::validate(const std::string& where) const {
 }
 
 CoupledInsertion::CoupledInsertion(NeedleModel& needle, SpgTissue& tissue, const ContactSurface& surface, const ContactOptions& contact,
-                                   std::vector<std::unique_ptr<SeparationModel>> separations, const CouplingOptions& coupling)
+                                   std::vector<std::unique_ptr<SeparationModel>> separations, const CouplingOptions& coupling,
+                                   const CuttingOptions& cutting)
     : needle_(needle),
       tissue_(tissue),
       options_(coupling),
       tissue_dynamics_(tissue, {}, coupling.tissue_body_acceleration_mm_per_ms2),
       contact_(surface, tissue.particles(), tissue.material(), contact),
+      cutting_(cutting.enabled() ? std::make_unique<CuttingResistance>(surface, tissue.particles(), cutting) : nullptr),
       separations_(std::move(separations)) {
+  loads_.contact = &contact_;
+  loads_.cutting = cutting_.get();
   options_.validate();
   NEEDLE_REQUIRE(needle.steps() == 0 && needle.time_ms() == 0, "the coupled run must start with a needle at t = 0");
   NEEDLE_REQUIRE(surface.reference_positions().rows() == needle.positions_mm().rows(), "the contact surface belongs to another needle mesh");
@@ -32,24 +36,35 @@ CoupledInsertion::CoupledInsertion(NeedleModel& needle, SpgTissue& tissue, const
   // The contact at t = 0 (particles placed within the skin already push), on both bodies.
   contact_.begin_step(tissue.particles(), needle.positions_mm(), needle.velocities_mm_per_ms(), 0.0,
                       tissue_dynamics_.time_step_ms(options_.contact_courant * contact_.stable_time_step_ms()));
-  needle_.apply_loads(contact_);
+  needle_.apply_loads(loads_);
   contact_.last_particle_forces(contact_force_N_);
   tissue_dynamics_.set_external_forces(contact_force_N_);
-  energy_.start(needle_.energy(), tissue_dynamics_.energy(), contact_);
+  energy_.start(needle_.energy(), tissue_dynamics_.energy(), contact_, cutting_.get());
 }
 
 void CoupledInsertion::step(double end_time_ms) {
   const double t = time_ms();
   const double dt = tissue_dynamics_.kick_and_drift(plan_time_step(end_time_ms));
   contact_.begin_step(tissue_.particles(), needle_.positions_mm(), needle_.velocities_mm_per_ms(), t, dt);
-  needle_.advance_to(t + dt, contact_);
+  needle_.advance_to(t + dt, loads_);
   contact_.end_step(contact_force_N_);
   tissue_dynamics_.finish_step(&contact_force_N_);
   for (const std::unique_ptr<SeparationModel>& separation : separations_) separation->apply(tissue_, needle_);
   ++steps_;
   last_dt_ms_ = dt;
-  energy_.update(needle_.energy(), tissue_dynamics_.energy(), contact_);
+  energy_.update(needle_.energy(), tissue_dynamics_.energy(), contact_, cutting_.get());
   check_health();
+}
+
+void CoupledInsertion::StepLoads::needle_forces(const Eigen::MatrixX3d& x, const Eigen::MatrixX3d& v, double t, NodalForces& f) {
+  contact->needle_forces(x, v, t, f);
+  if (cutting) cutting->needle_forces(x, v, t, f);
+}
+
+ContactReport CoupledInsertion::contact() const {
+  ContactReport report = contact_.report();
+  if (cutting_) cutting_->add_to(report);
+  return report;
 }
 
 double CoupledInsertion::plan_time_step(double end_time_ms) const {

@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "solver/contact/cutting_resistance.h"
 #include "solver/contact/needle_tissue_contact.h"
 #include "solver/insertion/insertion_energy.h"
 #include "solver/needle/needle_model.h"
@@ -47,8 +48,10 @@ struct CouplingOptions {
 class CoupledInsertion {
  public:
   // The needle, the tissue and the surface are advanced or read by this object; they must outlive it.
+  // The cutting resistance (contact/cutting_resistance.h) joins the contact as a load on the needle when enabled.
   CoupledInsertion(NeedleModel& needle, SpgTissue& tissue, const ContactSurface& surface, const ContactOptions& contact,
-                   std::vector<std::unique_ptr<SeparationModel>> separations, const CouplingOptions& coupling);
+                   std::vector<std::unique_ptr<SeparationModel>> separations, const CouplingOptions& coupling,
+                   const CuttingOptions& cutting = {});
 
   // One coupling step, shortened to land on end_time_ms.
   void step(double end_time_ms);
@@ -57,7 +60,8 @@ class CoupledInsertion {
   long steps() const { return steps_; }
   double last_step_ms() const { return last_dt_ms_; }
   long needle_steps() const { return needle_.steps(); }
-  const ContactReport& contact() const { return contact_.report(); }
+  // The loads on the needle at the last evaluation: the contact's, with the cutting resistance's added in.
+  ContactReport contact() const;
   NeedleTissueContact& contact_model() { return contact_; }
   const NeedleTissueContact& contact_model() const { return contact_; }
   const InsertionEnergy& energy() const { return energy_; }
@@ -66,6 +70,7 @@ class CoupledInsertion {
   double max_depth_mm() const { return max_depth_; }
   long bonds_broken() const { return static_cast<long>(tissue_.bonds().broken_count); }
   const std::vector<std::unique_ptr<SeparationModel>>& separations() const { return separations_; }
+  const CuttingResistance* cutting() const { return cutting_.get(); }  // null when cutting costs nothing
   // Momenta (g mm/ms).
   Eigen::Vector3d tissue_momentum() const;
   Eigen::Vector3d needle_momentum() const { return needle_.momentum(); }
@@ -82,6 +87,13 @@ class CoupledInsertion {
   CouplingOptions options_;
   TissueDynamics tissue_dynamics_;
   NeedleTissueContact contact_;
+  std::unique_ptr<CuttingResistance> cutting_;
+  // What the needle feels in a step: the contact, then the cutting resistance.
+  struct StepLoads : NeedleLoads {
+    NeedleTissueContact* contact = nullptr;
+    CuttingResistance* cutting = nullptr;
+    void needle_forces(const Eigen::MatrixX3d& x_mm, const Eigen::MatrixX3d& v_mm_per_ms, double time_ms, NodalForces& force_N) override;
+  } loads_;
   std::vector<std::unique_ptr<SeparationModel>> separations_;
   std::vector<Vec3d> contact_force_N_;  // the contact's force on each particle at the step's end
   InsertionEnergy energy_;

@@ -5,14 +5,15 @@
 
 namespace needle {
 
-void InsertionEnergy::start(const NeedleEnergy& needle, const EnergyBalance& tissue, const NeedleTissueContact& contact) {
+void InsertionEnergy::start(const NeedleEnergy& needle, const EnergyBalance& tissue, const NeedleTissueContact& contact,
+                            const CuttingResistance* cutting) {
   needle_initial_mJ = needle.initial_mJ;
   initial_penalty_energy_mJ = contact.report().penalty_energy_mJ;
   tissue_initial_kinetic_mJ = tissue.initial_kinetic_mJ;
-  update(needle, tissue, contact);
+  update(needle, tissue, contact, cutting);
 }
 
-void InsertionEnergy::update(const NeedleEnergy& n, const EnergyBalance& t, const NeedleTissueContact& contact) {
+void InsertionEnergy::update(const NeedleEnergy& n, const EnergyBalance& t, const NeedleTissueContact& contact, const CuttingResistance* cutting) {
   tissue_kinetic_mJ = t.kinetic_mJ;
   tissue_internal_mJ = -t.model_work_mJ;
   tissue_reaction_work_mJ = t.constraint_work_mJ;
@@ -24,6 +25,7 @@ void InsertionEnergy::update(const NeedleEnergy& n, const EnergyBalance& t, cons
   contact_work_mJ = n.external_work_mJ + t.external_work_mJ;
   penalty_energy_mJ = contact.report().penalty_energy_mJ;
   friction_dissipation_mJ = contact.friction_dissipation_mJ();
+  if (cutting) friction_dissipation_mJ += cutting->work_mJ();
   relinearisation_energy_mJ = contact.relinearisation_energy_mJ();
 }
 

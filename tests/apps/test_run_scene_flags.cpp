@@ -202,7 +202,7 @@ TEST_CASE("needle run --cutting-pressure-mpa: the scene says so, the tip pays th
   const RunFiles paid_cut = run_sb_into_small_block("cutting_paid", "--cutting-pressure-mpa 0.2");
   CHECK_FALSE(free_cut.scene["tissue"]["contact"].contains("cutting_pressure_MPa"));
   CHECK(paid_cut.scene["tissue"]["contact"]["cutting_pressure_MPa"].get<double>() == 0.2);
-  CHECK(free_cut.summary["cutting"]["work_mJ"].get<double>() == 0.0);
+  CHECK_FALSE(free_cut.summary.contains("cutting"));  // no cutting resistance, no entry
   const double work_mJ = paid_cut.summary["cutting"]["work_mJ"].get<double>();
   const double free_drag_N = std::abs(free_cut.history.column("contact_force_x_N").back());
   const double paid_drag_N = std::abs(paid_cut.history.column("contact_force_x_N").back());

@@ -44,13 +44,13 @@ struct Insertion {
   CoupledInsertion run;
 
   Insertion(const TetMesh& mesh, double mass_scaling_dt_ms, bool rigid, const InsertionProfile& profile, const Eigen::Vector3d& direction,
-            const ParticleSet& particles, const CouplingOptions& coupling, const ContactOptions& contact = {})
+            const ParticleSet& particles, const CouplingOptions& coupling, const ContactOptions& contact = {}, const CuttingOptions& cutting = {})
       : needle(mesh, NeedleMaterial{}, mass_scaling_dt_ms),
         surface(needle.mesh()),
         tissue(particles, TissueMaterial{}, SpgOptions{}),
         model(make_needle_model(rigid ? "rigid" : "fe", {needle, driven_base_supports(needle.mesh(), profile, direction), std::nullopt, {}})),
         dynamics(*model),
-        run(dynamics, tissue, surface, contact, make_separation_models(SeparationOptions{}, surface), coupling) {}
+        run(dynamics, tissue, surface, contact, make_separation_models(SeparationOptions{}, surface), coupling, cutting) {}
 
   void run_to_end() {
     const double end = dynamics_end();
@@ -254,10 +254,10 @@ TEST_CASE("A cutting pressure loads the tip facets along their normals and the b
   const TetMesh mesh = small_needle(tip, true, 0.5);
   const InsertionProfile profile = quick_profile(2.0);
   const double pressure_MPa = 0.2;
-  ContactOptions contact;
-  contact.cutting_pressure_MPa = pressure_MPa;
-  for (const FacetPlane& f : tip.facets) contact.cutting_facets.push_back(f.name);
-  Insertion ins(mesh, 0.0, true, profile, Eigen::Vector3d::UnitX(), block(3.0, 1.6, 1.2, 0.4, true), CouplingOptions{}, contact);
+  CuttingOptions cutting;
+  cutting.pressure_MPa = pressure_MPa;
+  for (const FacetPlane& f : tip.facets) cutting.facets.push_back(f.name);
+  Insertion ins(mesh, 0.0, true, profile, Eigen::Vector3d::UnitX(), block(3.0, 1.6, 1.2, 0.4, true), CouplingOptions{}, ContactOptions{}, cutting);
   const double end = profile.end_time_ms();
   const auto& names = ins.surface.tag_names();
   const size_t top = static_cast<size_t>(std::find(names.begin(), names.end(), "top") - names.begin());
@@ -284,7 +284,8 @@ TEST_CASE("A cutting pressure loads the tip facets along their normals and the b
     }
   }
   const InsertionEnergy& e = ins.run.energy();
-  const double cutting_mJ = ins.run.contact_model().cutting_work_mJ();
+  REQUIRE(ins.run.cutting() != nullptr);
+  const double cutting_mJ = ins.run.cutting()->work_mJ();
   INFO("cutting work " << cutting_mJ << " mJ, along the drive " << work_along_drive_mJ << " mJ, drive " << e.drive_work_mJ
                        << " mJ, balance " << e.balance_error() << "; top facet " << largest_top_N << " N against p_c A/2 "
                        << pressure_MPa * top_area_half_mm2 << " N");
