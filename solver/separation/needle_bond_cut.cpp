@@ -1,12 +1,10 @@
 #include "solver/separation/needle_bond_cut.h"
 
-#include <chrono>
-#include <nlohmann/json.hpp>
-
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
-
+#include <nlohmann/json.hpp>
 
 namespace needle {
 

@@ -1,10 +1,9 @@
 #include "solver/separation/symmetry_slit.h"
 
-#include <nlohmann/json.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "core/input_error.h"
 #include "mesher/particle_lattice.h"

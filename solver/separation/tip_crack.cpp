@@ -1,10 +1,9 @@
 #include "solver/separation/tip_crack.h"
 
 #include <chrono>
-#include <nlohmann/json.hpp>
-
 #include <cmath>
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "core/input_error.h"
 
