@@ -1,7 +1,10 @@
 // `needle`: the toolkit's one command. Each subcommand lives in its own file.
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fmt/format.h>
+#include <sstream>
 
 #include "apps/material_test_command.h"
 #include "apps/calibrate_command.h"
@@ -13,6 +16,29 @@
 #include "apps/tip_command.h"
 #include "core/input_error.h"
 #include "core/solver_error.h"
+
+namespace {
+
+// A number given on the command line must be finite: options read NaN as "not given", so "--travel-mm nan"
+// would otherwise quietly run the default. Every value of every option given (list items split at commas)
+// that reads as a number is checked before any command runs.
+void refuse_non_finite_numbers(const CLI::App& command) {
+  for (const CLI::Option* option : command.get_options()) {
+    if (option->count() == 0) continue;
+    for (const std::string& result : option->results()) {
+      std::stringstream items(result);
+      for (std::string item; std::getline(items, item, ',');) {
+        char* end = nullptr;
+        const double value = std::strtod(item.c_str(), &end);
+        const bool whole_number = end != item.c_str() && *end == '\0';
+        NEEDLE_REQUIRE(!whole_number || std::isfinite(value),
+                       fmt::format("{} {}: give a finite number", option->get_name(false, true), result));
+      }
+    }
+  }
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"needle: design biopsy needle tips - grinding CAD, meshing and insertion simulation"};
@@ -26,6 +52,7 @@ int main(int argc, char** argv) {
   needle::add_run_command(app);
   needle::add_paper_command(app);
   needle::add_calibrate_command(app);
+  for (CLI::App* command : app.get_subcommands({})) command->parse_complete_callback([command] { refuse_non_finite_numbers(*command); });
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -288,3 +288,18 @@ TEST_CASE("--overwrite replaces only a run folder the toolkit wrote, never the c
   CHECK(again.exit_code == 0);
   CHECK(fs::exists(dir / "run" / "summary.json"));
 }
+
+TEST_CASE("A number flag given NaN or infinity is refused before anything runs, whichever command", "[apps][sim]") {
+  // Options read NaN as "not given": without the check, --travel-mm nan quietly ran the default 30 mm.
+  const fs::path dir = fresh_folder("non_finite");
+  for (const std::string& args : std::vector<std::string>{"run --preset SB --travel-mm nan", "run --preset SB --tissue-E-MPa inf",
+                                                           "run --preset SB --tissue-size-mm 40,-inf,2", "tip --preset SB --rod-length-mm NaN",
+                                                           "tip --d-a nan", "stiffness --preset SB --free-length-mm 1e999", "mesh --preset SB --size-mm nan"}) {
+    const auto r = run(args + " --out " + (dir / "out").string(), true);
+    INFO(args << ": " << r.out);
+    CHECK(r.exit_code == 2);
+    CHECK(r.out.find("give a finite number") != std::string::npos);
+    CHECK(std::count(r.out.begin(), r.out.end(), '\n') == 1);
+    CHECK(!fs::exists(dir / "out"));
+  }
+}
