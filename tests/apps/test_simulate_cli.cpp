@@ -248,7 +248,7 @@ TEST_CASE("needle run: no needle, two needles or a bad number exit 2 with one li
 }
 
 
-TEST_CASE("--overwrite replaces only a run folder the toolkit wrote, never the current folder or one above it", "[apps][sim][gmsh]") {
+TEST_CASE("needle simulate --overwrite replaces only a run folder the toolkit wrote, never the current folder or one above it", "[apps][sim][gmsh]") {
   // A needle-alone scene of a fraction of a second.
   const fs::path dir = fresh_folder("overwrite_guard");
   write(dir / "scene.json", R"({"needle": {"plain_rod": true, "length_mm": 6, "mesh": {"order": 1, "size_mm": 0.5}},)"
