@@ -1,5 +1,7 @@
 #include "runs/json_lines.h"
 
+#include <algorithm>
+
 #include <fmt/format.h>
 #include <fstream>
 #include <iterator>
@@ -58,7 +60,14 @@ class LineTrackingBuilder : public nlohmann::json_sax<json> {
   bool end_array() override { return close(); }
   bool key(string_t& k) override {
     key_ = k;
-    doc_.lines[pointers_.back() + "/" + json_pointer_token(k)] = line_;
+    const std::string pointer = pointers_.back() + "/" + json_pointer_token(k);
+    const auto earlier = doc_.lines.find(pointer);
+    if (earlier != doc_.lines.end() && stack_.back()->contains(k)) {
+      std::string name = pointer.substr(1);
+      std::replace(name.begin(), name.end(), '/', '.');
+      throw InputError(fmt::format("{}:{}: {}: duplicate key (also on line {}; a key may be given once)", doc_.source, line_, name, earlier->second));
+    }
+    doc_.lines[pointer] = line_;
     return true;
   }
   bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception& e) override {

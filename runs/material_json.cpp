@@ -3,6 +3,7 @@
 #include <fstream>
 
 #include "runs/json_object_reader.h"
+#include "runs/json_file.h"
 
 namespace needle {
 
@@ -30,7 +31,7 @@ TissueMaterial read_material_file(const std::string& path) {
   NEEDLE_REQUIRE(in, fmt::format("cannot read material file '{}'", path));
   nlohmann::json json;
   try {
-    in >> json;
+    json = parse_json_refusing_duplicates(in, path);
   } catch (const nlohmann::json::parse_error& e) {
     throw InputError(fmt::format("{}: not valid JSON ({})", path, e.what()));
   }

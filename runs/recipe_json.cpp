@@ -6,6 +6,7 @@
 
 #include "runs/json_object_reader.h"
 #include "core/input_error.h"
+#include "runs/json_file.h"
 
 namespace needle {
 namespace {
@@ -89,7 +90,7 @@ GrindingRecipe read_recipe_file(const std::string& path) {
   NEEDLE_REQUIRE(in.good(), fmt::format("cannot read recipe '{}': no such file", path));
   json root;
   try {
-    root = json::parse(in);
+    root = parse_json_refusing_duplicates(in, path);
   } catch (const json::parse_error& e) {
     throw InputError(fmt::format("{}: not valid JSON: {}", path, e.what()));
   }

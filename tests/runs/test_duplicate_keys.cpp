@@ -1,0 +1,45 @@
+// A key given twice in one JSON object is refused in every file the toolkit reads (scenes, recipes, tissue
+// cards, summaries), naming the key (and, in scenes, both lines): nlohmann keeps the last one without a word.
+#include <catch2/catch.hpp>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "core/input_error.h"
+#include "runs/json_file.h"
+#include "runs/material_json.h"
+#include "runs/recipe_json.h"
+#include "runs/scene.h"
+
+namespace {
+
+std::string refusal(const std::function<void()>& read) {
+  try {
+    read();
+  } catch (const needle::InputError& e) {
+    return e.what();
+  }
+  return "accepted";
+}
+
+std::string file_with(const std::string& name, const std::string& text) {
+  const std::filesystem::path path = std::filesystem::temp_directory_path() / name;
+  std::ofstream(path) << text;
+  return path.string();
+}
+
+}  // namespace
+
+TEST_CASE("A key given twice in one object is refused in scenes, recipes, tissue cards and result files", "[apps][scene]") {
+  CHECK(refusal([] { needle::parse_scene("{\n \"motion\": {\"travel_mm\": 3,\n  \"travel_mm\": 5}\n}\n", "dup.json"); }) ==
+        "dup.json:3: motion.travel_mm: duplicate key (also on line 2; a key may be given once)");
+  // The same key in two objects is two keys.
+  CHECK(refusal([] { needle::parse_scene(R"({"motion": {"travel_mm": 3}, "cannula": {"enabled": true}, "tissue": {"enabled": true}})", "ok.json"); }) ==
+        "accepted");
+  const std::string recipe = file_with("needle_dup_recipe.json", R"({"name": "x", "rod": {"diameter_mm": 1.27, "diameter_mm": 1.0}})");
+  CHECK(refusal([&] { needle::read_recipe_file(recipe); }) == recipe + ": duplicate key 'rod.diameter_mm' (a key may be given once in its object)");
+  const std::string card = file_with("needle_dup_card.json", R"({"E_MPa": 0.1, "E_MPa": 0.2})");
+  CHECK(refusal([&] { needle::read_material_file(card); }).find("duplicate key 'E_MPa'") != std::string::npos);
+  const std::string summary = file_with("needle_dup_summary.json", R"({"runs": [{"a": 1}, {"a": 2, "a": 3}]})");
+  CHECK(refusal([&] { needle::read_json_file(summary, "summary"); }).find("duplicate key 'runs.a'") != std::string::npos);
+}
