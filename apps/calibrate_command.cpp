@@ -16,6 +16,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "apps/cli_checks.h"
 #include "studies/calibration_steps.h"
 #include "runs/insertion_run.h"
 #include "apps/scene_overrides.h"
@@ -192,7 +193,7 @@ void add_calibrate_command(CLI::App& app) {
                 "run lies within twice this, this calibration's or one of the same scene already in OUT/runs (default 0.2; 0: none)");
   add_scene_override_options(c, o->overrides);
   c->add_flag("--quiet", o->quiet, "No progress bars or result lines");
-  c->add_option("--threads", o->threads, "Worker threads (default: the scene's; 0: all cores)");
+  c->add_option("--threads", o->threads, "Worker threads (default: the scene's; 0: all cores)")->check(count_check());
   c->callback([o] { calibrate(*o); });
 }
 

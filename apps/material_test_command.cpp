@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
+#include "apps/cli_checks.h"
 #include "runs/material_json.h"
 #include "core/input_error.h"
 #include "geometry/mesh_io.h"
@@ -150,7 +151,7 @@ void add_material_test_command(CLI::App& app) {
   cmd->add_option("--lateral", o->lateral, "Lateral faces: guided (servo to zero lateral stress; no necking) or free")->capture_default_str();
   cmd->add_option("--stabilization", o->stabilization, "SPG stabilization: penalty, filter or none")->capture_default_str();
   cmd->add_option("--dilation", o->test.spg.dilation, "SPG support radius / spacing")->capture_default_str();
-  cmd->add_option("--threads", o->threads, "Worker threads (0: all cores)")->capture_default_str();
+  cmd->add_option("--threads", o->threads, "Worker threads (0: all cores)")->capture_default_str()->check(count_check());
   cmd->add_flag("--json", o->json_output, "Print the curve and its error as JSON on stdout (no files)");
   cmd->add_option("--csv", o->csv_path, "Curve as CSV (without --json)")->capture_default_str();
   cmd->add_option("--png", o->png_path, "Plot of the curve against the input law (without --json)")->capture_default_str();

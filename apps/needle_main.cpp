@@ -55,8 +55,12 @@ int main(int argc, char** argv) {
   for (CLI::App* command : app.get_subcommands({})) command->parse_complete_callback([command] { refuse_non_finite_numbers(*command); });
   try {
     app.parse(argc, argv);
+  } catch (const CLI::Success& e) {
+    return app.exit(e);  // --help: the help text, exit 0
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // A flag the command does not know, a value that does not convert, a required flag missing: the project's one line.
+    fmt::print(stderr, "needle: error: {} (--help lists the flags)\n", e.what());
+    return 2;
   } catch (const needle::InputError& e) {
     fmt::print(stderr, "needle: error: {}\n", e.what());
     return 2;

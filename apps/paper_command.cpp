@@ -11,6 +11,7 @@
 #include <sstream>
 #include <tuple>
 
+#include "apps/cli_checks.h"
 #include "runs/insertion_run.h"
 #include "apps/scene_overrides.h"
 #include "runs/json_file.h"
@@ -169,7 +170,7 @@ void add_paper_command(CLI::App& app) {
   c->add_flag("--rerun", o->rerun, "Run every needle again even if OUT/runs holds a run of the same scene");
   c->add_flag("--no-tips", o->no_tips, "Skip the tip pictures (they need the CAD booleans, a few seconds each)");
   c->add_flag("--quiet", o->quiet, "No progress bars or result lines");
-  c->add_option("--threads", o->threads, "Worker threads (default: the scene's; 0: all cores)");
+  c->add_option("--threads", o->threads, "Worker threads (default: the scene's; 0: all cores)")->check(count_check());
   c->callback([o, c] {
     // The command that regenerates the report (its runs are reused).
     std::string& line = o->command_line;

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <memory>
 
+#include "apps/cli_checks.h"
 #include "runs/insertion_run.h"
 #include "apps/scene_overrides.h"
 #include "runs/scene.h"
@@ -86,12 +87,12 @@ void add_run_command(CLI::App& app) {
                 "Tissue Young's modulus (the calibrated parameter; default: the SB calibration data/paper/calibration_sb.json, 0.078; "
                 "the paper's card: 0.665)");
   c->add_option("--calibration", o->calibration_file, "Take the tissue's E from this calibration (`needle calibrate`'s calibration.json)");
-  c->add_option("--frames", o->frames, "ParaView frames over the run (default 20; 0: none)");
+  c->add_option("--frames", o->frames, "ParaView frames over the run (default 20; 0: none)")->check(count_check());
   c->add_flag("--no-subcycling", o->no_subcycling, "Tissue takes the needle's step (the plain full model; slow)");
   c->add_flag("--rigid", o->rigid, "Rigid needle (no deflection)");
   c->add_flag("--overwrite", o->run.overwrite, "Replace an existing run folder when the run ends");
   c->add_flag("--quiet", o->run.quiet, "No progress bar or result line");
-  c->add_option("--threads", o->run.threads, "Worker threads (default: the scene's; 0: all cores)");
+  c->add_option("--threads", o->run.threads, "Worker threads (default: the scene's; 0: all cores)")->check(count_check());
   c->callback([o] { run(*o); });
 }
 

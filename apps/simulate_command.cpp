@@ -5,6 +5,7 @@
 
 #include <memory>
 
+#include "apps/cli_checks.h"
 #include "runs/insertion_run.h"
 #include "runs/needle_alone_run.h"
 #include "runs/scene.h"
@@ -36,7 +37,7 @@ void add_simulate_command(CLI::App& app) {
   c->add_option("--out", o->run.out_dir, "Run folder to create")->required();
   c->add_flag("--overwrite", o->run.overwrite, "Replace an existing run folder when the run ends");
   c->add_flag("--quiet", o->run.quiet, "No progress bar or result line");
-  c->add_option("--threads", o->run.threads, "Worker threads (default: the scene's solver.threads; 0: all cores)");
+  c->add_option("--threads", o->run.threads, "Worker threads (default: the scene's solver.threads; 0: all cores)")->check(count_check());
   c->callback([o] { run_simulation(*o); });
 }
 

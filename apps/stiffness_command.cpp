@@ -9,6 +9,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
+#include "apps/cli_checks.h"
 #include "runs/needle_build.h"
 #include "apps/tip_source.h"
 #include "geometry/exact_measures.h"
@@ -141,7 +142,7 @@ void add_stiffness_command(CLI::App& app) {
   c->add_option("--nu", o->material.poisson_ratio, "Poisson's ratio of the needle")->capture_default_str();
   c->add_option("--density-g-per-cm3", o->density_g_per_cm3, "Density of the needle")->capture_default_str();
   c->add_option("--modes", o->modes, "Number of vibration modes to compute")->capture_default_str();
-  c->add_option("--threads", o->threads, "Worker threads (0: all cores)")->capture_default_str();
+  c->add_option("--threads", o->threads, "Worker threads (0: all cores)")->capture_default_str()->check(count_check());
   c->add_flag("--json", o->json_output, "Print the results as JSON");
   c->callback([o] { run_stiffness(*o); });
 }

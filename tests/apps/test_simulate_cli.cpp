@@ -303,3 +303,23 @@ TEST_CASE("A number flag given NaN or infinity is refused before anything runs, 
     CHECK(!fs::exists(dir / "out"));
   }
 }
+
+TEST_CASE("Unknown flags, values that do not convert and negative counts get the project's one line and exit 2", "[apps][sim]") {
+  // CLI11's own words used to leak with its own exit codes; negative --threads and --frames quietly became the defaults.
+  const fs::path dir = fresh_folder("cli_errors");
+  for (const auto& [args, message] : std::vector<std::pair<std::string, std::string>>{
+           {"run --preset SB --threads -1", "--threads: must be a whole number 0 or more (got -1)"},
+           {"run --preset SB --frames 2.5", "--frames: must be a whole number 0 or more (got 2.5)"},
+           {"simulate scene.json --threads -2", "--threads: must be a whole number 0 or more (got -2)"},
+           {"run --preset SB --travel-mm abc", "Could not convert: --travel-mm = abc"},
+           {"tip --preset SB --bogus-flag", "--bogus-flag"}}) {
+    const auto r = run(args + " --out " + (dir / "out").string(), true);
+    INFO(args << ": " << r.out);
+    CHECK(r.exit_code == 2);
+    CHECK(r.out.rfind("needle: error: ", 0) == 0);
+    CHECK(r.out.find(message) != std::string::npos);
+    CHECK(std::count(r.out.begin(), r.out.end(), '\n') == 1);
+    CHECK(!fs::exists(dir / "out"));
+  }
+  CHECK(run("run --help").exit_code == 0);
+}
