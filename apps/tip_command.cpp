@@ -125,6 +125,8 @@ void run_tip(const TipOptions& o) {
   if (!o.analyze_file.empty()) {
     NEEDLE_REQUIRE(!o.source.given(),
                    "--analyze reads a tip from a file: do not combine it with --preset, --d-a or --recipe");
+    NEEDLE_REQUIRE(o.out_file.empty() && o.png_file.empty(),
+                   "--analyze only reads and measures a surface: --out and --png write a tip built from --preset, --d-a or --recipe");
     analyze_file(o);
     return;
   }
@@ -132,6 +134,8 @@ void run_tip(const TipOptions& o) {
   // Check output paths before any work, so a bad path costs nothing and writes nothing.
   SurfaceFormat format{};
   if (!o.out_file.empty()) format = surface_format_from_path(o.out_file, o.ascii_stl);
+  NEEDLE_REQUIRE(o.png_file.empty() || std::filesystem::path(o.png_file).extension() == ".png",
+                 fmt::format("'{}': --png writes a PNG picture and needs a .png file", o.png_file));
   for (const std::string& path : {o.out_file, o.png_file}) {
     if (path.empty()) continue;
     const std::filesystem::path dir = std::filesystem::path(path).parent_path();

@@ -36,6 +36,11 @@ TEST_CASE("needle tip --d-a writes every format; bad input writes nothing", "[ap
   CHECK(fs::file_size(dir / "t.glb") > 1000);
   CHECK(fs::file_size(dir / "t.png") > 1000);
   CHECK(run("tip --analyze " + d + "/t.glb --json").exit_code == 0);
+  // --analyze writes nothing, so an --out or --png beside it is refused rather than ignored.
+  const auto analyze_out = run("tip --analyze " + d + "/t.glb --out " + d + "/u.stl", true);
+  CHECK(analyze_out.exit_code == 2);
+  CHECK(analyze_out.out.find("--analyze only reads and measures a surface") != std::string::npos);
+  CHECK(!fs::exists(dir / "u.stl"));
 
   fs::remove_all(dir);
   fs::create_directories(dir);
@@ -46,5 +51,9 @@ TEST_CASE("needle tip --d-a writes every format; bad input writes nothing", "[ap
   CHECK(run("tip --analyze " + d + "/nothing.stl").exit_code == 2);
   CHECK(run("tip --preset SB --out /nonexistent-folder/x.stl").exit_code == 2);
   CHECK(run("tip --bogus-flag").exit_code != 0);
+  // --png writes PNG data: another extension is refused before any work, not written under the wrong name.
+  const auto jpg = run("tip --preset SB --png " + d + "/t.jpg", true);
+  CHECK(jpg.exit_code == 2);
+  CHECK(jpg.out.find("--png writes a PNG picture and needs a .png file") != std::string::npos);
   CHECK(fs::is_empty(dir));
 }
