@@ -201,8 +201,8 @@ class InsertionRunModel : public RunModel {
     NEEDLE_REQUIRE(scene.tissue.enabled, "run_insertion needs a scene with tissue.enabled");
     const auto start = Clock::now();
     built_ = build_scene_needle(scene.needle);
-    rigid_ = scene.needle.model == "rigid";  // no mass scaling: a rigid needle takes any step
-    needle_ = std::make_unique<FeNeedle>(built_.mesh, scene.needle.material, rigid_ ? 0.0 : scene.solver.mass_scaling_dt_ms);
+    const bool mass_scaled = needle_model(scene.needle.model).mass_scaled;  // a rigid needle takes any step: no mass scaling
+    needle_ = std::make_unique<FeNeedle>(built_.mesh, scene.needle.material, mass_scaled ? scene.solver.mass_scaling_dt_ms : 0.0);
     ContactSurfaceOptions surface_options;
     surface_options.voxel_mm = scene.tissue.contact.voxel_mm;
     surface_ = std::make_unique<ContactSurface>(needle_->mesh(), surface_options);
@@ -230,7 +230,8 @@ class InsertionRunModel : public RunModel {
     const FeNeedle& n = *needle_;
     const ContactSurface& surface = *surface_;
     return {fmt::format("needle {}: {} T{} elements, {} nodes, meshed in {:.2f} s{}", built_.name, built_.mesh.num_tets(),
-                        built_.mesh.order == 2 ? 10 : 4, built_.mesh.num_nodes(), built_.mesh_seconds, rigid_ ? " (rigid)" : ""),
+                        built_.mesh.order == 2 ? 10 : 4, built_.mesh.num_nodes(), built_.mesh_seconds,
+                        scene_.needle.model == "fe" ? "" : " (" + scene_.needle.model + ")"),
             fmt::format("needle stable step {:.4g} ms (unscaled {:.4g} ms); added mass {:.3g} % in {} elements", n.stable_time_step_ms(),
                         n.unscaled_time_step_ms(), 100 * n.added_mass_g() / n.physical_mass_g(), n.mass_scaled_elements()),
             fmt::format("contact surface: {} triangles, level set {} voxels of {} mm ({:.1f} MiB) built in {:.2f} s", surface.num_triangles(),
@@ -294,7 +295,6 @@ class InsertionRunModel : public RunModel {
  private:
   const Scene& scene_;
   SceneNeedle built_;
-  bool rigid_ = false;
   std::unique_ptr<FeNeedle> needle_;
   std::unique_ptr<ContactSurface> surface_;
   ParticleSet particles_;

@@ -63,7 +63,7 @@ void read_needle(SceneObject o, NeedleScene& n, const std::string& scene_folder)
   // needle.model names a registered needle model (solver/needle/needle_models.h); rigid: true is the older
   // way to say model "rigid", and the effective scene still says it so that stored scenes read the same.
   n.model = o.text("model", n.model);
-  require_needle_model(n.model, o.where("model"));
+  needle_model(n.model, o.where("model"));  // refuses an unknown name with the file and line
   if (o.boolean("rigid", n.model == "rigid")) {
     NEEDLE_REQUIRE(n.model == "fe" || n.model == "rigid", fmt::format("{}: rigid: true contradicts model '{}'", o.where("rigid"), n.model));
     n.model = "rigid";

@@ -97,7 +97,7 @@ class NeedleTissueContact : public NeedleLoads {
   // carry their mid-step velocities (after velocity Verlet's drift); the needle is at the step's start.
   void begin_step(const TissueParticles& particles, const Eigen::MatrixX3d& needle_x_mm, const Eigen::MatrixX3d& needle_v_mm_per_ms,
                   double start_time_ms, double dt_ms);
-  // The contact forces on the needle at time_ms within the step (a NeedleDynamics::ExternalForces).
+  // The contact forces on the needle at time_ms within the step (NeedleLoads).
   void needle_forces(const Eigen::MatrixX3d& needle_x_mm, const Eigen::MatrixX3d& needle_v_mm_per_ms, double time_ms,
                      NodalForces& force_N) override;
   // Ends the step: particle_force (one per particle, overwritten) is the contact at the step's end.

@@ -73,33 +73,24 @@ void NeedleDynamics::set_initial_state(const Eigen::MatrixX3d& x, const Eigen::M
   energy_.initial_mJ = energy_.kinetic_mJ + energy_.strain_mJ;
 }
 
-void NeedleDynamics::set_external_forces(ExternalForces external) {
-  for (const auto& [node, f] : external_) force_.row(node) -= f.transpose();
-  external_.clear();
-  external_fn_ = std::move(external);
-  if (external_fn_) {
-    external_fn_(x_, v_, time_ms_, external_);
-    for (const auto& [node, f] : external_) {
-      NEEDLE_REQUIRE(node >= 0 && node < x_.rows(), "external needle force on a node that does not exist");
-      force_.row(node) += f.transpose();
-    }
-  }
-  a_ = force_.array().colwise() / mass_.array();
-}
-
 void NeedleDynamics::advance_to(double end_time_ms) {
   while (time_ms_ < end_time_ms - 1e-12 * std::max(1.0, std::abs(end_time_ms))) step(end_time_ms);
 }
 
 void NeedleDynamics::apply_loads(NeedleLoads& loads) {
-  set_external_forces([&loads](const Eigen::MatrixX3d& x, const Eigen::MatrixX3d& v, double t, NodalForces& f) { loads.needle_forces(x, v, t, f); });
+  for (const auto& [node, f] : external_) force_.row(node) -= f.transpose();
+  external_.clear();
+  loads_ = &loads;
+  loads.needle_forces(x_, v_, time_ms_, external_);
+  for (const auto& [node, f] : external_) {
+    NEEDLE_REQUIRE(node >= 0 && node < x_.rows(), "external needle force on a node that does not exist");
+    force_.row(node) += f.transpose();
+  }
+  a_ = force_.array().colwise() / mass_.array();
 }
 
 void NeedleDynamics::advance_to(double end_time_ms, NeedleLoads& loads) {
-  struct Using {  // the loads for this call only, also when a step throws
-    NeedleLoads*& slot;
-    ~Using() { slot = nullptr; }
-  } using_loads{loads_ = &loads};
+  loads_ = &loads;
   advance_to(end_time_ms);
 }
 
@@ -123,9 +114,8 @@ void NeedleDynamics::compute_forces(const Eigen::MatrixX3d& velocity) {
   force_ += cannula_force_;
   old_external_.swap(external_);
   external_.clear();
-  if (loads_ || external_fn_) {
-    if (loads_) loads_->needle_forces(x_, velocity, time_ms_, external_);
-    else external_fn_(x_, velocity, time_ms_, external_);
+  if (loads_) {
+    loads_->needle_forces(x_, velocity, time_ms_, external_);
     for (const auto& [node, f] : external_) force_.row(node) += f.transpose();
   }
   if (!force_.allFinite() || !std::isfinite(energy_.strain_mJ))

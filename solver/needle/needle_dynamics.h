@@ -9,7 +9,6 @@
 // whose relative error is the integrator's drift. The run stops with a SolverError (never NaN) on a
 // non-finite state, on energy drift beyond a bound, or on cannula penetration beyond a bound.
 #include <Eigen/Dense>
-#include <functional>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -51,18 +50,12 @@ class NeedleDynamics : public NeedleModel {
   double time_step_ms() const override { return dt_ms_; }
   // Replaces the state before the first step (a pre-deformed or moving start); InputError after.
   void set_initial_state(const Eigen::MatrixX3d& x_mm, const Eigen::MatrixX3d& v_mm_per_ms);
-  // External nodal forces (the tissue's contact): a function evaluated with the elastic forces at every
-  // step (positions, mid-step velocities, time) that lists (node, force) pairs. Set it before the
-  // first step or between steps; it is evaluated once at once.
-  using NodalForces = needle::NodalForces;
-  using ExternalForces = std::function<void(const Eigen::MatrixX3d& x_mm, const Eigen::MatrixX3d& v_mm_per_ms, double time_ms,
-                                            NodalForces& force_N)>;
-  void set_external_forces(ExternalForces external);
   // One step of time_step_ms() (shortened to land on end_time_ms if given).
   void step(double end_time_ms = std::numeric_limits<double>::infinity());
-  // Steps until end_time_ms (subcycling within a longer step of another body) under the external forces set.
+  // Steps until end_time_ms (subcycling within a longer step of another body) under the loads last given.
   void advance_to(double end_time_ms);
-  // NeedleModel: the loads as the external forces (apply_loads evaluates them at once), then the steps.
+  // NeedleModel: the loads (the tissue's contact), evaluated with the elastic forces at every step (positions,
+  // mid-step velocities, time); apply_loads evaluates them at once, before the first step or between steps.
   void apply_loads(NeedleLoads& loads) override;
   void advance_to(double end_time_ms, NeedleLoads& loads) override;
 
@@ -95,8 +88,7 @@ class NeedleDynamics : public NeedleModel {
   double dt_ms_ = 0, time_ms_ = 0;
   long steps_ = 0;
   Eigen::MatrixX3d x_, v_, a_, force_, old_force_, cannula_force_, old_cannula_force_;
-  ExternalForces external_fn_;
-  NeedleLoads* loads_ = nullptr;  // advance_to's loads (instead of external_fn_) while it runs
+  NeedleLoads* loads_ = nullptr;  // the loads last given (none: no external forces)
   NodalForces external_, old_external_;
   Eigen::MatrixX3d v_before_;  // step scratch: velocities of the constrained nodes before the step
   Eigen::MatrixX3d v_half_;

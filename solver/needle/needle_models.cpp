@@ -26,23 +26,20 @@ std::string known_names() {
 
 const std::vector<NeedleModelEntry>& needle_models() {
   static const std::vector<NeedleModelEntry> models = {
-      {"fe", "explicit T4/T10 finite elements with the driven base and the rigid cannula, subcycled in the tissue's step", make_fe},
-      {"rigid", "every node follows the drive: no deflection, no cannula, no step limit", make_rigid},
+      {"fe", "explicit T4/T10 finite elements with the driven base and the rigid cannula, subcycled in the tissue's step", true, make_fe},
+      {"rigid", "every node follows the drive: no deflection, no cannula, no step limit", false, make_rigid},
   };
   return models;
 }
 
-void require_needle_model(const std::string& name, const std::string& where) {
+const NeedleModelEntry& needle_model(const std::string& name, const std::string& where) {
   for (const NeedleModelEntry& m : needle_models())
-    if (m.name == name) return;
+    if (m.name == name) return m;
   throw InputError(fmt::format("{}: unknown needle model '{}' (known: {})", where, name, known_names()));
 }
 
 std::unique_ptr<NeedleModel> make_needle_model(const std::string& name, const NeedleModelInputs& inputs) {
-  for (const NeedleModelEntry& m : needle_models())
-    if (m.name == name) return m.make(inputs);
-  require_needle_model(name, "needle.model");
-  return nullptr;
+  return needle_model(name).make(inputs);
 }
 
 }  // namespace needle

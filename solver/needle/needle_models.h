@@ -21,6 +21,7 @@ struct NeedleModelInputs {
 
 struct NeedleModelEntry {
   std::string name, description;
+  bool mass_scaled;  // it takes explicit steps, which selective mass scaling lengthens (a rigid needle takes any step)
   std::unique_ptr<NeedleModel> (*make)(const NeedleModelInputs& inputs);
 };
 
@@ -28,7 +29,8 @@ struct NeedleModelEntry {
 const std::vector<NeedleModelEntry>& needle_models();
 // The model registered as name; InputError listing the known names otherwise.
 std::unique_ptr<NeedleModel> make_needle_model(const std::string& name, const NeedleModelInputs& inputs);
-// InputError unless name is registered (scene readers check before building anything).
-void require_needle_model(const std::string& name, const std::string& where);
+// The model registered as name; InputError naming where and the known names otherwise (scene readers check
+// before building anything).
+const NeedleModelEntry& needle_model(const std::string& name, const std::string& where = "needle.model");
 
 }  // namespace needle
