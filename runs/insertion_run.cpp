@@ -241,7 +241,7 @@ class InsertionRunModel : public RunModel {
                         scene_.tissue.spacing_mm, particles_.spacing_mm.minCoeff(), tissue_->bonds().bonds.size(), setup_s_),
             fmt::format("run to {:.6g} ms: needle step {:.4g} ms, first coupling step {:.4g} ms (tissue {:.4g}, contact {:.4g})", end_time_ms(),
                         needle_model_->time_step_ms(), run_->tissue_dynamics().time_step_ms(), tissue_->stable_time_step_ms(),
-                        scene_.solver.coupling.contact_courant * run_->contact_model().stable_time_step_ms())};
+                        run_->contact_model().max_time_step_ms(scene_.solver.coupling.contact_courant))};
   }
   double end_time_ms() const override { return scene_.motion.end_time_ms(); }
   double time_ms() const override { return run_->time_ms(); }

@@ -139,6 +139,9 @@ void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc) {
   }
   if (o.has("contact")) {
     SceneObject c = o.child("contact");
+    t.contact.law = c.text("law", t.contact.law);
+    NEEDLE_REQUIRE(t.contact.law == "penalty" || t.contact.law == "projection",
+                   c.where("law") + ": must be penalty or projection (got '" + t.contact.law + "')");
     t.contact.stiffness_factor = c.number("stiffness_factor", t.contact.stiffness_factor, within(1e-3, 1e4));
     t.contact.skin_mm = c.quantity("skin", Dimension::length, t.contact.skin_mm, non_negative());
     t.contact.voxel_mm = c.quantity("voxel", Dimension::length, t.contact.voxel_mm, within(1e-3, 0.2));
@@ -244,6 +247,7 @@ json scene_to_json(const Scene& s) {
     tissue["contact"]["slit_lead_mm"] = t.separation.slit.lead_mm;
   }
   if (t.cutting.pressure_MPa > 0) tissue["contact"]["cutting_pressure_MPa"] = t.cutting.pressure_MPa;
+  if (t.contact.law != "penalty") tissue["contact"]["law"] = t.contact.law;
   if (t.separation.crack.enabled()) {
     tissue["contact"]["crack_reach_mm"] = t.separation.crack.reach_mm;
     tissue["contact"]["crack_angles_deg"] = t.separation.crack.angles_deg;

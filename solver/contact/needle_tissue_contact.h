@@ -1,40 +1,15 @@
 #pragma once
-// Frictional penalty contact between the needle's surface and the tissue particles, integrated at the
-// needle's (fine) step inside the tissue's (coarse) step.
+// The contact between the needle's surface and the tissue particles: what every contact law shares (the
+// geometry: particles pulled back to the needle's reference configuration, the level set's signed distance and
+// normal, the surface triangle under a point; the report, the contacts, the classification) and the interface
+// the coupled step drives (begin_step, the needle's loads at its own steps, end_step). Two laws implement it,
+// chosen by ContactOptions::law (contact_laws.h):
+//   penalty    (penalty_contact.h): a frictional penalty force, integrated at the needle's (fine) step
+//              inside the tissue's (coarse) step; its stiffness caps the coupling step;
+//   projection (projection_contact.h): a kinematic contact that moves the particles out of the needle at the
+//              end of each step and exchanges the impulse; it does not limit the step.
 //
-// Contact law, for a particle at p pulled back to the needle's reference configuration X (ContactSurface::pull_back)
-// (contact_surface.h), with signed distance phi(X) to the needle surface:
-//   gap g = skin - phi > 0 means contact (the skin keeps particles off the true surface);
-//   normal   f_n = k_i g n,   k_i = stiffness_factor * M * V_i / h_i^2  (M the tissue's P-wave modulus,
-//            V_i, h_i the particle's volume and spacing: a multiple of the particle's own stiffness);
-//   k is capped on the needle's side at needle_stiffness_scale m_c / dt_needle^2 (m_c the needle's mass at
-//   the contact point, from its nodes by the same weights), so that a light node at the tip is never made
-//   unstable at the needle's step (as LS-DYNA's SOFT=1 contact does);
-//   damping  f_d = -zeta 2 sqrt(k m_r) (v_rel . n) n, m_r the reduced mass of particle and contact point, while in contact and as long as f_n + f_d pushes;
-//            it damps the contact's own oscillation, which the two clocks would otherwise feed;
-//   friction f_t = -min(mu f_n, c_i |v_t|) v_t / |v_t|,  v_t the particle's tangential velocity relative
-//            to the needle's surface point, c = min(m_i / Dt, m_c / dt_needle) / 2 (a viscous cap that
-//            regularises sticking and never reverses the sliding within either body's step);
-//   n is the level set's outward normal, turned with the current surface triangle under the point.
-// The particle gets f = f_n + f_t; the needle gets -f on the three nodes of that triangle by
-// barycentric weights. Forces are booked per facet tag (top, bottom, sides, lancets, groove floor ...).
-//
-// The cost of cutting is a needle load of its own (cutting_resistance.h), not part of this law.
-//
-// Multi-rate integration over one tissue step [t, t + Dt] (insertion/coupled_insertion.h):
-//   begin_step: the particles move on straight lines over the step (velocity Verlet's drift), so their
-//     path is known. The geometry (triangle, weights, normal, phi) is found once, at t, for every particle
-//     that can reach the surface within the step;
-//   needle_forces: at each of the needle's substeps the gap is updated linearly from both bodies' motion
-//     since t, g = g(t) - n . (dx_particle - dx_surface point), and the forces go to the needle;
-//   end_step: the particles receive the last evaluation's forces, i.e. the contact at t + Dt with both
-//     bodies at their new positions: for the particles this is plain velocity Verlet with the contact as
-//     one more force (stable below the contact's own step limit, which caps Dt).
-// Each side integrates the same force history with its own velocity Verlet, so energy is consistent on
-// both; the momentum the two receive differs only by the curvature of the force within one step (the
-// needle integrates the substep history, the particles the trapezoid of its end values). Measured in
-// the tests. (Giving the particles the step's mean force instead would exchange momentum exactly, but
-// it evaluates the penalty half a step late for them, which pumps energy in: tried and rejected.)
+// The cost of cutting is a needle load of its own (cutting_resistance.h), not part of a contact law.
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
 #include <limits>
@@ -45,14 +20,16 @@
 #include "solver/contact/contact_surface.h"
 #include "solver/tissue/spg_tissue.h"
 #include "solver/needle/needle_model.h"
+#include "solver/tissue/tissue_dynamics.h"
 
 namespace needle {
 
 struct ContactOptions {
+  std::string law = "penalty";    // "penalty" or "projection" (contact_laws.h)
   double friction = 0.18;         // Coulomb coefficient needle-tissue (paper)
-  double stiffness_factor = 30.0; // penalty stiffness over the particle's own (see above); at 30 it lets no particle
+  double stiffness_factor = 30.0; // penalty stiffness over the particle's own (penalty_contact.h); at 30 it lets no particle
                                   // deeper than 0.023 mm inside the needle over the paper's 30 mm (10: 0.07 mm; docs/notebook/paper_studies.md)
-  double skin_mm = 0.02;          // contact starts this far outside the surface (0.04 until the skin study showed AMB's
+  double skin_mm = 0.02;          // contact starts this far outside the surface (projection: particles are put back this far out) (0.04 until the skin study showed AMB's
                                   // deflection converging only below 0.02 mm)
   double damping_ratio = 0.2;     // normal viscous damping, fraction of critical 2 sqrt(k m_r) (LS-DYNA's VDC)
   double needle_stiffness_scale = 0.1;  // cap of k on the needle's side, x m_c / dt_needle^2
@@ -88,36 +65,38 @@ struct InsideReport {
 
 class NeedleTissueContact : public NeedleLoads {
  public:
-  NeedleTissueContact(const ContactSurface& surface, const TissueParticles& particles, const TissueMaterial& material,
-                      const ContactOptions& options);
+  NeedleTissueContact(const ContactSurface& surface, const TissueParticles& particles, const ContactOptions& options);
 
+  // The law's name, as ContactOptions::law spells it.
+  virtual std::string law() const = 0;
   // The needle's nodal masses and its step (infinity for a rigid needle: no cap), before the first step.
   void set_needle(const Eigen::VectorXd& nodal_mass_g, double time_step_ms);
+  // The longest coupling step the law allows, contact_courant being the fraction of its own stable step a
+  // step may take (infinity: the law does not limit the step).
+  virtual double max_time_step_ms(double contact_courant) const = 0;
   // Starts a tissue step from start_time_ms over dt_ms: the particles are at their end positions and
   // carry their mid-step velocities (after velocity Verlet's drift); the needle is at the step's start.
-  void begin_step(const TissueParticles& particles, const Eigen::MatrixX3d& needle_x_mm, const Eigen::MatrixX3d& needle_v_mm_per_ms,
-                  double start_time_ms, double dt_ms);
-  // The contact forces on the needle at time_ms within the step (NeedleLoads).
-  void needle_forces(const Eigen::MatrixX3d& needle_x_mm, const Eigen::MatrixX3d& needle_v_mm_per_ms, double time_ms,
-                     NodalForces& force_N) override;
-  // Ends the step: particle_force (one per particle, overwritten) is the contact at the step's end.
-  void end_step(std::vector<Vec3d>& particle_force);
+  virtual void begin_step(const TissueParticles& particles, const Eigen::MatrixX3d& needle_x_mm, const Eigen::MatrixX3d& needle_v_mm_per_ms,
+                          double start_time_ms, double dt_ms) = 0;
+  // (NeedleLoads::needle_forces: the contact's forces on the needle at time_ms within the step.)
+  // Ends the step, the needle at the step's end: the law acts on the tissue between its drift and its
+  // second half (a kinematic law moves the particles through `tissue`) and writes the forces the tissue's
+  // second half takes, one per particle (overwritten).
+  virtual void end_step(TissueDynamics& tissue, const Eigen::MatrixX3d& needle_x_mm, const Eigen::MatrixX3d& needle_v_mm_per_ms,
+                        std::vector<Vec3d>& particle_force) = 0;
   // The particles' forces of the last evaluation (the state at t = 0 before any step).
-  void last_particle_forces(std::vector<Vec3d>& particle_force) const;
+  virtual void last_particle_forces(std::vector<Vec3d>& particle_force) const = 0;
 
   // The state of the last force evaluation (in contact, forces per facet, energy) and of the last
-  // begin_step (particles inside).
+  // step's penetration check.
   const ContactReport& report() const { return report_; }
-  // Energy dissipated by friction and normal damping since the start.
+  // Energy dissipated by the contact (friction, damping, inelastic impact) since the start.
   double friction_dissipation_mJ() const { return friction_dissipation_mJ_; }
-  // Sum of the penalty energy's jumps where each step finds the geometry anew (the gap is linearised
-  // within a step): energy the contact's discretisation adds (> 0) or removes. A diagnostic.
+  // Energy the law's discretisation adds (> 0) or removes, outside the balance: a diagnostic (penalty_contact.h).
   double relinearisation_energy_mJ() const { return relinearisation_energy_mJ_; }
   // Classifies every particle against the needle at the given state (level set; no forces).
   InsideReport classify(const TissueParticles& particles, const Eigen::MatrixX3d& needle_x_mm);
 
-  // The contact's own stable step for a particle alone: min over particles of 2 sqrt(m_i / k_i).
-  double stable_time_step_ms() const { return stable_dt_ms_; }
   // Per particle: 1 if in contact at the last step's end.
   std::vector<std::uint8_t> in_contact() const;
   // The contacts at the last step's end (or at t = 0): particle and surface triangle (-1: a node fallback).
@@ -128,7 +107,7 @@ class NeedleTissueContact : public NeedleLoads {
   const ContactSurface& surface() const { return surface_; }
   const ContactOptions& options() const { return options_; }
 
- private:
+ protected:
   // A particle that may touch the needle during the step, with the geometry found at the step's start.
   struct Pair {
     int particle = -1;
@@ -137,36 +116,36 @@ class NeedleTissueContact : public NeedleLoads {
     Eigen::Vector3d particle_start = Eigen::Vector3d::Zero(), particle_velocity = Eigen::Vector3d::Zero();
     Eigen::Vector3d surface_start = Eigen::Vector3d::Zero();  // the needle's surface point at the start
     double gap_start = 0;                                      // skin - phi at the start
-    double stiffness = 0, damping = 0, friction_cap = 0;       // the law's constants over the step
+    double stiffness = 0, damping = 0, friction_cap = 0;       // the penalty law's constants over the step
   };
   struct Probe {  // one particle's geometric query
     bool near = false, inside = false;
     double phi = 0;
     Pair pair;
   };
-  void build_node_grid(const Eigen::MatrixX3d& needle_x);
-  int nearest_surface_node(const Eigen::Vector3d& p, const Eigen::MatrixX3d& needle_x) const;
   // Level-set query of every particle at positions x (reach: how far outside the skin still counts as near).
   void probe(const std::vector<Vec3d>& x, const Eigen::MatrixX3d& needle_x, const std::vector<double>& reach);
   Eigen::Vector3d surface_point(const Pair& pair, const Eigen::MatrixX3d& needle) const;
-  void record_contacts();  // contacts_ from the last evaluation (at a step's end, not at every substep)
+  // The needle's mass at a pair's contact point, by the force's weights (infinity without masses).
+  double needle_mass_at(const Pair& pair) const;
+  // Adds a force on the needle at a pair's contact point to the nodal forces and books it on its facet.
+  void book_needle_force(const Pair& pair, const Eigen::Vector3d& force_on_needle, double normal_N, double friction_N, NodalForces& out);
+  void clear_report_forces();
 
   const ContactSurface& surface_;
   ContactOptions options_;
-  std::vector<double> stiffness_, mass_;
+  std::vector<double> mass_;
   Eigen::VectorXd needle_mass_;
   double needle_dt_ms_ = std::numeric_limits<double>::infinity();
-  double stable_dt_ms_ = 0;
   std::vector<Probe> probes_;
-  std::vector<Pair> pairs_;
-  std::vector<Eigen::Vector3d> pair_force_;                   // per pair, at the current evaluation
-  std::vector<Eigen::Vector3d> pair_elastic_force_;           // per pair, the penalty part of pair_force_
-  std::vector<Eigen::Vector3d> pair_dissipative_impulse_;     // per pair, damper + friction integrated over the step
-  std::vector<Eigen::Vector3d> previous_force_;               // the particles' forces of the last step's end ...
-  std::vector<int> previous_particles_;                       // ... and their particles
-  std::vector<std::pair<int, int>> contacts_;                 // (particle, triangle) in contact at the last step's end
-  double step_start_ms_ = 0, step_dt_ms_ = 0, last_eval_ms_ = 0, last_friction_power_mW_ = 0, friction_dissipation_mJ_ = 0, relinearisation_energy_mJ_ = 0;
+  std::vector<std::pair<int, int>> contacts_;  // (particle, triangle) in contact at the last step's end
+  double friction_dissipation_mJ_ = 0, relinearisation_energy_mJ_ = 0;
   ContactReport report_;
+
+ private:
+  void build_node_grid(const Eigen::MatrixX3d& needle_x);
+  int nearest_surface_node(const Eigen::Vector3d& p, const Eigen::MatrixX3d& needle_x) const;
+
   // Grid of the current surface nodes (rebuilt per query): sorted (cell, node).
   double node_cell_mm_ = 0;
   Eigen::Vector3d node_origin_ = Eigen::Vector3d::Zero();

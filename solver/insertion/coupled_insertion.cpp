@@ -6,6 +6,7 @@
 
 #include "core/input_error.h"
 #include "core/solver_error.h"
+#include "solver/contact/contact_laws.h"
 
 namespace needle {
 
@@ -24,35 +25,35 @@ CoupledInsertion::CoupledInsertion(NeedleModel& needle, SpgTissue& tissue, const
       tissue_(tissue),
       options_(coupling),
       tissue_dynamics_(tissue, {}, coupling.tissue_body_acceleration_mm_per_ms2),
-      contact_(surface, tissue.particles(), tissue.material(), contact),
+      contact_(make_tissue_contact(surface, tissue.particles(), tissue.material(), contact)),
       cutting_(cutting.enabled() ? std::make_unique<CuttingResistance>(surface, tissue.particles(), cutting) : nullptr),
       separations_(std::move(separations)) {
-  loads_.contact = &contact_;
+  loads_.contact = contact_.get();
   loads_.cutting = cutting_.get();
   options_.validate();
   NEEDLE_REQUIRE(needle.steps() == 0 && needle.time_ms() == 0, "the coupled run must start with a needle at t = 0");
   NEEDLE_REQUIRE(surface.reference_positions().rows() == needle.positions_mm().rows(), "the contact surface belongs to another needle mesh");
-  contact_.set_needle(needle.nodal_mass_g(), needle.time_step_ms());
-  // The contact at t = 0 (particles placed within the skin already push), on both bodies.
-  contact_.begin_step(tissue.particles(), needle.positions_mm(), needle.velocities_mm_per_ms(), 0.0,
-                      tissue_dynamics_.time_step_ms(options_.contact_courant * contact_.stable_time_step_ms()));
+  contact_->set_needle(needle.nodal_mass_g(), needle.time_step_ms());
+  // The contact at t = 0 (particles placed within a penalty's skin already push), on both bodies.
+  contact_->begin_step(tissue.particles(), needle.positions_mm(), needle.velocities_mm_per_ms(), 0.0,
+                       tissue_dynamics_.time_step_ms(contact_->max_time_step_ms(options_.contact_courant)));
   needle_.apply_loads(loads_);
-  contact_.last_particle_forces(contact_force_N_);
+  contact_->last_particle_forces(contact_force_N_);
   tissue_dynamics_.set_external_forces(contact_force_N_);
-  energy_.start(needle_.energy(), tissue_dynamics_.energy(), contact_, cutting_.get());
+  energy_.start(needle_.energy(), tissue_dynamics_.energy(), *contact_, cutting_.get());
 }
 
 void CoupledInsertion::step(double end_time_ms) {
   const double t = time_ms();
   const double dt = tissue_dynamics_.kick_and_drift(plan_time_step(end_time_ms));
-  contact_.begin_step(tissue_.particles(), needle_.positions_mm(), needle_.velocities_mm_per_ms(), t, dt);
+  contact_->begin_step(tissue_.particles(), needle_.positions_mm(), needle_.velocities_mm_per_ms(), t, dt);
   needle_.advance_to(t + dt, loads_);
-  contact_.end_step(contact_force_N_);
+  contact_->end_step(tissue_dynamics_, needle_.positions_mm(), needle_.velocities_mm_per_ms(), contact_force_N_);
   tissue_dynamics_.finish_step(&contact_force_N_);
   for (const std::unique_ptr<SeparationModel>& separation : separations_) separation->apply(tissue_, needle_);
   ++steps_;
   last_dt_ms_ = dt;
-  energy_.update(needle_.energy(), tissue_dynamics_.energy(), contact_, cutting_.get());
+  energy_.update(needle_.energy(), tissue_dynamics_.energy(), *contact_, cutting_.get());
   check_health();
 }
 
@@ -62,7 +63,7 @@ void CoupledInsertion::StepLoads::needle_forces(const Eigen::MatrixX3d& x, const
 }
 
 ContactReport CoupledInsertion::contact() const {
-  ContactReport report = contact_.report();
+  ContactReport report = contact_->report();
   if (cutting_) cutting_->add_to(report);
   return report;
 }
@@ -72,7 +73,7 @@ double CoupledInsertion::plan_time_step(double end_time_ms) const {
   double cap = end_time_ms - t;
   NEEDLE_REQUIRE(cap > 0, "the insertion has reached its end time");
   if (options_.max_step_ms > 0) cap = std::min(cap, options_.max_step_ms);
-  cap = std::min(cap, options_.contact_courant * contact_.stable_time_step_ms());
+  cap = std::min(cap, contact_->max_time_step_ms(options_.contact_courant));
   const double needle_dt = needle_.time_step_ms();
   if (!options_.subcycling) cap = std::min(cap, needle_dt);
   double dt = tissue_dynamics_.time_step_ms(cap);
@@ -82,11 +83,11 @@ double CoupledInsertion::plan_time_step(double end_time_ms) const {
 }
 
 void CoupledInsertion::check_health() {
-  max_inside_ = std::max(max_inside_, contact_.report().particles_inside);
-  max_depth_ = std::max(max_depth_, contact_.report().max_depth_mm);
-  if (contact_.report().max_depth_mm > options_.max_depth_mm)
+  max_inside_ = std::max(max_inside_, contact_->report().particles_inside);
+  max_depth_ = std::max(max_depth_, contact_->report().max_depth_mm);
+  if (contact_->report().max_depth_mm > options_.max_depth_mm)
     throw SolverError(fmt::format("runaway penetration: a tissue particle is {:.3g} mm inside the needle at t = {:.6g} ms (limit {:.3g} mm)",
-                                  contact_.report().max_depth_mm, time_ms(), options_.max_depth_mm));
+                                  contact_->report().max_depth_mm, time_ms(), options_.max_depth_mm));
   // The balance is checked once the work done from outside exceeds a nanojoule and the energy the run
   // started with (particles inside the contact's skin at t = 0 release theirs in the first steps, when
   // the drive has done almost nothing: measured against that, the release is not a drift).

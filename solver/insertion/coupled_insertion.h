@@ -62,8 +62,8 @@ class CoupledInsertion {
   long needle_steps() const { return needle_.steps(); }
   // The loads on the needle at the last evaluation: the contact's, with the cutting resistance's added in.
   ContactReport contact() const;
-  NeedleTissueContact& contact_model() { return contact_; }
-  const NeedleTissueContact& contact_model() const { return contact_; }
+  NeedleTissueContact& contact_model() { return *contact_; }
+  const NeedleTissueContact& contact_model() const { return *contact_; }
   const InsertionEnergy& energy() const { return energy_; }
   double max_energy_error() const { return max_energy_error_; }
   int max_particles_inside() const { return max_inside_; }
@@ -86,7 +86,7 @@ class CoupledInsertion {
   SpgTissue& tissue_;
   CouplingOptions options_;
   TissueDynamics tissue_dynamics_;
-  NeedleTissueContact contact_;
+  std::unique_ptr<NeedleTissueContact> contact_;  // the law the contact options name (contact_laws.h)
   std::unique_ptr<CuttingResistance> cutting_;
   // What the needle feels in a step: the contact, then the cutting resistance.
   struct StepLoads : NeedleLoads {

@@ -209,6 +209,27 @@ StepReport TissueDynamics::finish_step(const std::vector<Vec3d>* external_force_
   return report;
 }
 
+double TissueDynamics::apply_impulses(std::vector<std::pair<std::int32_t, Vec3d>>& impulses) {
+  NEEDLE_REQUIRE(drifted_, "impulses act between kick_and_drift and finish_step");
+  TissueParticles& p = tissue_.particles();
+  const double dt = step_dt_ms_;
+  double work = 0;
+  for (auto& [particle, J] : impulses) {
+    NEEDLE_REQUIRE(particle >= 0 && particle < p.size(), "an impulse on a particle that does not exist");
+    const size_t s = static_cast<size_t>(particle);
+    for (int axis = 0; axis < 3; ++axis)
+      if (constrained_mask_[s] & (1 << axis)) J[axis] = 0;
+    const Vec3d dv = J / p.mass_g[s];
+    Vec3d& v = p.velocity_mm_per_ms[s];
+    work += J.dot(v + 0.5 * dv);
+    v += dv;
+    displacement_[s] += dt * dv;
+    p.position_mm[s] += dt * dv;
+  }
+  energy_.external_work_mJ += work;
+  return work;
+}
+
 StepReport TissueDynamics::step(double max_dt_ms) {
   kick_and_drift(max_dt_ms);
   return finish_step(nullptr);

@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include "solver/tissue/spg_tissue.h"
@@ -64,12 +65,18 @@ class TissueDynamics {
   //     on non-finite forces or energy.
   double kick_and_drift(double max_dt_ms = std::numeric_limits<double>::infinity());
   StepReport finish_step(const std::vector<Vec3d>* external_force_N = nullptr);
+  // Between the two halves, a kinematic contact's impulses (particle, J in g mm/ms): each particle's mid-step
+  // velocity changes by J/m and its end position, through the drift, by dt J/m. Components the particle's
+  // constraints hold (fixed, symmetry) are dropped from J, in place, so what is returned acted. Returns their
+  // work, J . (v_before + v_after) / 2 (the exact change of kinetic energy), booked as external work.
+  double apply_impulses(std::vector<std::pair<std::int32_t, Vec3d>>& impulse_g_mm_per_ms);
   // Both halves with the external forces held.
   StepReport step(double max_dt_ms = std::numeric_limits<double>::infinity());
 
   double time_ms() const { return time_ms_; }
   std::int64_t steps() const { return steps_; }
   const EnergyBalance& energy() const { return energy_; }
+  const TissueParticles& particles() const { return tissue_.particles(); }
   const std::vector<Vec3d>& external_forces() const { return external_force_; }
   // Sum over a constraint's particles of the force the tissue exerts on them (N): minus the reaction.
   Eigen::Vector3d constraint_internal_force_N(size_t constraint) const;

@@ -6,7 +6,7 @@
 
 #include "mesher/needle_mesher.h"
 #include "solver/contact/contact_surface.h"
-#include "solver/contact/needle_tissue_contact.h"
+#include "solver/contact/penalty_contact.h"
 
 using namespace needle;
 
@@ -43,7 +43,7 @@ struct Step {
 };
 
 // One step of dt with a rigid, resting needle: the contact's begin, one evaluation at the step's end, its end.
-Step contact_step(NeedleTissueContact& contact, const TissueParticles& particles, const Eigen::MatrixX3d& x, double dt) {
+Step contact_step(PenaltyContact& contact, const TissueParticles& particles, const Eigen::MatrixX3d& x, double dt) {
   const Eigen::MatrixX3d v = Eigen::MatrixX3d::Zero(x.rows(), 3);
   Step s;
   contact.begin_step(particles, x, v, 0.0, dt);
@@ -74,7 +74,7 @@ TEST_CASE("Contact law: a particle within the skin is pushed out by k g n, k the
     // Above the rod's top line (y up), halfway along, where the faceted surface meets the cylinder.
     const Eigen::Vector3d top = mesh.X.row(nearest_node(mesh, Eigen::Vector3d(-2.0, kRadius, 0.0))).transpose();
     const TissueParticles p = one_particle(top + Eigen::Vector3d(0, depth, 0), Eigen::Vector3d::Zero(), h);
-    NeedleTissueContact contact(surface, p, material, options);
+    PenaltyContact contact(surface, p, material, options);
     contact.set_needle(Eigen::VectorXd::Ones(mesh.num_nodes()), std::numeric_limits<double>::infinity());  // rigid: no cap
     const Step s = contact_step(contact, p, mesh.X, 1e-4);
     const double k = options.stiffness_factor * M * h * h * h / (h * h);
@@ -94,7 +94,7 @@ TEST_CASE("Contact law: a particle within the skin is pushed out by k g n, k the
   // Beyond the skin, nothing.
   const Eigen::Vector3d top = mesh.X.row(nearest_node(mesh, Eigen::Vector3d(-2.0, kRadius, 0.0))).transpose();
   const TissueParticles far = one_particle(top + Eigen::Vector3d(0, 0.05, 0), Eigen::Vector3d::Zero(), h);
-  NeedleTissueContact contact(surface, far, material, options);
+  PenaltyContact contact(surface, far, material, options);
   contact.set_needle(Eigen::VectorXd::Ones(mesh.num_nodes()), std::numeric_limits<double>::infinity());
   const Step s = contact_step(contact, far, mesh.X, 1e-4);
   CHECK(s.particle_force[0].norm() == 0.0);
@@ -132,7 +132,7 @@ TEST_CASE("Contact law: a particle sliding over a facet feels Coulomb friction a
     const Eigen::Vector3d v = speed * along + approach_speed * n;  // mm/ms; approach_speed < 0 moves toward the needle
     const Eigen::Vector3d start = centroid + 0.01 * n;
     const TissueParticles p = one_particle(start + dt * v, v, h);
-    NeedleTissueContact contact(surface, p, material, options);
+    PenaltyContact contact(surface, p, material, options);
     contact.set_needle(Eigen::VectorXd::Ones(mesh.num_nodes()), std::numeric_limits<double>::infinity());
     const Step s = contact_step(contact, p, mesh.X, dt);
     const double k = options.stiffness_factor * M * h, m = p.mass_g[0];
