@@ -217,9 +217,17 @@ class InsertionRunModel : public RunModel {
                    "a crack from the tip point needs a needle with a ground tip point: a preset, d_a or a recipe (not a plain rod or a mesh file)");
     std::vector<std::unique_ptr<SeparationModel>> separations = make_separation_models(scene.tissue.separation, *surface_);
     setup_s_ = std::chrono::duration<double>(Clock::now() - start).count();
+    NeedleDynamicsOptions dynamics = scene_dynamics_options(scene);
+    // The implicit needle's step by default: about a quarter of the tissue's stable step at the start, and a
+    // whole fraction of the history interval (the run lands on each record), so that every coupling step is a
+    // whole number of needle steps as the tissue's step drifts: one factorisation for the run.
+    if (dynamics.implicit_step_ms <= 0) {
+      const double interval = scene.output.history_interval_ms;
+      dynamics.implicit_step_ms = interval / std::ceil(interval / (0.25 * tissue_->stable_time_step_ms()));
+    }
     needle_model_ = make_needle_model(scene.needle.model, {*needle_, driven_base_supports(needle_->mesh(), scene.motion, scene.direction),
                                                            scene.cannula.enabled ? std::optional<CannulaOptions>(scene.cannula) : std::nullopt,
-                                                           scene_dynamics_options(scene)});
+                                                           dynamics});
     run_ = std::make_unique<CoupledInsertion>(*needle_model_, *tissue_, *surface_, scene.tissue.contact, std::move(separations),
                                               scene.solver.coupling, cutting);
     tip_ = nearest_node(needle_->mesh(), built_.tip_point);

@@ -164,6 +164,7 @@ void read_solver(SceneObject o, SolverScene& s) {
   s.mass_scaling_dt_ms = o.quantity("mass_scaling_dt", Dimension::time, s.mass_scaling_dt_ms, non_negative());
   s.max_energy_error = o.number("max_energy_error", s.max_energy_error, positive());
   s.max_penetration_mm = o.quantity("max_penetration", Dimension::length, s.max_penetration_mm, positive());
+  s.implicit_needle_step_ms = o.quantity("implicit_needle_step", Dimension::time, s.implicit_needle_step_ms, within(0.0, 0.1));
   s.threads = o.integer("threads", s.threads, 0, 1024);
   CouplingOptions& c = s.coupling;
   c.subcycling = o.boolean("subcycling", c.subcycling);
@@ -259,6 +260,12 @@ json scene_to_json(const Scene& s) {
   // Written only when used: stored scenes (the paper's model, neither) stay as they were.
   if (s.motion.decel_time_ms > 0) motion["decel_time_ms"] = s.motion.decel_time_ms;
   if (s.motion.hold_ms > 0) motion["hold_ms"] = s.motion.hold_ms;
+  json solver = {{"courant", s.solver.courant}, {"mass_scaling_dt_ms", s.solver.mass_scaling_dt_ms},
+                 {"max_energy_error", s.solver.max_energy_error}, {"max_penetration_mm", s.solver.max_penetration_mm},
+                 {"threads", s.solver.threads}, {"subcycling", s.solver.coupling.subcycling},
+                 {"max_coupling_step_ms", s.solver.coupling.max_step_ms}, {"contact_courant", s.solver.coupling.contact_courant},
+                 {"max_contact_depth_mm", s.solver.coupling.max_depth_mm}};
+  if (s.needle.model == "implicit") solver["implicit_needle_step_ms"] = s.solver.implicit_needle_step_ms;
   return {
       {"needle", needle},
       {"motion", motion},
@@ -266,11 +273,7 @@ json scene_to_json(const Scene& s) {
                    {"front_x_mm", c.front_x_mm}, {"length_mm", c.length_mm}, {"friction", c.friction},
                    {"penalty_scale", c.penalty_scale}}},
       {"tissue", tissue},
-      {"solver", {{"courant", s.solver.courant}, {"mass_scaling_dt_ms", s.solver.mass_scaling_dt_ms},
-                  {"max_energy_error", s.solver.max_energy_error}, {"max_penetration_mm", s.solver.max_penetration_mm},
-                  {"threads", s.solver.threads}, {"subcycling", s.solver.coupling.subcycling},
-                  {"max_coupling_step_ms", s.solver.coupling.max_step_ms}, {"contact_courant", s.solver.coupling.contact_courant},
-                  {"max_contact_depth_mm", s.solver.coupling.max_depth_mm}}},
+      {"solver", solver},
       {"output", {{"history_interval_ms", s.output.history_interval_ms}, {"frames", s.output.frames}}},
   };
 }

@@ -52,6 +52,7 @@ NeedleDynamicsOptions scene_dynamics_options(const Scene& scene) {
   o.courant = scene.solver.courant;
   o.max_energy_error = scene.solver.max_energy_error;
   o.max_penetration_mm = scene.solver.max_penetration_mm;
+  o.implicit_step_ms = scene.solver.implicit_needle_step_ms;
   return o;
 }
 

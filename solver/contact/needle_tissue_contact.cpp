@@ -30,6 +30,7 @@ NeedleTissueContact::NeedleTissueContact(const ContactSurface& surface, const Ti
   options_.validate();
   mass_ = particles.mass_g;
   node_cell_mm_ = surface_.node_search_radius_mm();
+  report_.facets.assign(surface_.tag_names().size(), FacetContact{});
 }
 
 void NeedleTissueContact::set_needle(const Eigen::VectorXd& nodal_mass_g, double time_step_ms) {

@@ -77,8 +77,12 @@ double CoupledInsertion::plan_time_step(double end_time_ms) const {
   const double needle_dt = needle_.time_step_ms();
   if (!options_.subcycling) cap = std::min(cap, needle_dt);
   double dt = tissue_dynamics_.time_step_ms(cap);
-  // A whole number of needle steps per coupling step, so that the needle never takes a sliver of a step.
-  if (std::isfinite(needle_dt) && dt > needle_dt && dt < end_time_ms - t) dt = std::floor(dt / needle_dt) * needle_dt;
+  // A whole number of needle steps per coupling step, so that the needle never takes a sliver of a step; a
+  // coupling step shorter than the needle's is its half, quarter ... (an implicit needle keeps a factor for each).
+  if (std::isfinite(needle_dt) && dt < end_time_ms - t) {
+    if (dt > needle_dt) dt = std::floor(dt / needle_dt) * needle_dt;
+    else if (dt < needle_dt) dt = needle_dt / std::exp2(std::ceil(std::log2(needle_dt / dt)));
+  }
   return dt;
 }
 

@@ -37,6 +37,7 @@ struct NeedleDynamicsOptions {
   double courant = 0.9;                 // fraction of the stable step used
   double max_energy_error = 0.05;       // stop when the balance error exceeds this (after the first work)
   double max_penetration_mm = 0.05;     // stop when a node passes the cannula's bore by more
+  double implicit_step_ms = 0.0;        // the implicit needle's step (implicit_needle.h; > 0 to use it); the coupling step is a whole number of them
 };
 
 class NeedleDynamics : public NeedleModel {

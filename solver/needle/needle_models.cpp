@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "core/input_error.h"
+#include "solver/needle/implicit_needle.h"
 #include "solver/needle/rigid_needle.h"
 
 namespace needle {
@@ -10,6 +11,10 @@ namespace {
 
 std::unique_ptr<NeedleModel> make_fe(const NeedleModelInputs& in) {
   return std::make_unique<NeedleDynamics>(in.needle, in.supports, in.cannula, in.options);
+}
+
+std::unique_ptr<NeedleModel> make_implicit(const NeedleModelInputs& in) {
+  return std::make_unique<ImplicitNeedle>(in.needle, in.supports, in.cannula, in.options);
 }
 
 std::unique_ptr<NeedleModel> make_rigid(const NeedleModelInputs& in) {
@@ -27,6 +32,8 @@ std::string known_names() {
 const std::vector<NeedleModelEntry>& needle_models() {
   static const std::vector<NeedleModelEntry> models = {
       {"fe", "explicit T4/T10 finite elements with the driven base and the rigid cannula, subcycled in the tissue's step", true, make_fe},
+      {"implicit", "the same mesh, linear elastic, implicit Newmark steps on a factored matrix at the coupling step: no subcycling", false,
+       make_implicit},
       {"rigid", "every node follows the drive: no deflection, no cannula, no step limit", false, make_rigid},
   };
   return models;

@@ -1,0 +1,219 @@
+#include "solver/needle/implicit_needle.h"
+
+#include <Eigen/CholmodSupport>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "core/input_error.h"
+#include "core/solver_error.h"
+
+namespace needle {
+
+struct ImplicitNeedle::Factor {
+  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>> llt;
+};
+
+ImplicitNeedle::ImplicitNeedle(const FeNeedle& needle, NeedleSupports supports, const std::optional<CannulaOptions>& cannula,
+                               const NeedleDynamicsOptions& options)
+    : needle_(needle), supports_(std::move(supports)), options_(options) {
+  supports_.profile.validate();
+  NEEDLE_REQUIRE(supports_.clamped.empty(), "the implicit needle is driven at its base; clamped supports need the fe model");
+  NEEDLE_REQUIRE(!supports_.driven.empty(), "the implicit needle needs driven base nodes");
+  NEEDLE_REQUIRE(supports_.direction.allFinite() && supports_.direction.norm() > 0, "drive direction must be a non-zero vector");
+  NEEDLE_REQUIRE(std::isfinite(options_.implicit_step_ms) && options_.implicit_step_ms > 0,
+                 fmt::format("the implicit needle's step must be positive (got {} ms; scene key solver.implicit_needle_step_ms)", options_.implicit_step_ms));
+  supports_.direction.normalize();
+  step_ms_ = options_.implicit_step_ms;
+  const int n = needle.num_nodes();
+  mass_ = needle.nodal_mass_g();
+  std::vector<std::uint8_t> held(3 * static_cast<size_t>(n), 0);
+  for (int i : supports_.driven) {
+    NEEDLE_REQUIRE(i >= 0 && i < n, fmt::format("driven node {} does not exist", i));
+    for (int k = 0; k < 3; ++k) held[3 * static_cast<size_t>(i) + k] = 1;
+  }
+  for (int i : supports_.symmetry) {
+    NEEDLE_REQUIRE(i >= 0 && i < n, fmt::format("symmetry node {} does not exist", i));
+    held[3 * static_cast<size_t>(i) + 2] = 1;
+  }
+  std::vector<int> index(3 * static_cast<size_t>(n), -1);
+  for (int d = 0; d < 3 * n; ++d)
+    if (!held[static_cast<size_t>(d)]) {
+      index[static_cast<size_t>(d)] = static_cast<int>(free_dof_.size());
+      free_dof_.push_back(d);
+    }
+  K_ = needle.stiffness_matrix();
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(static_cast<size_t>(K_.nonZeros() / 2 + free_dof_.size()));
+  for (int col = 0; col < K_.outerSize(); ++col)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(K_, col); it; ++it) {
+      const int r = index[static_cast<size_t>(it.row())], c = index[static_cast<size_t>(it.col())];
+      if (r >= 0 && c >= 0 && r >= c) triplets.emplace_back(r, c, it.value());
+    }
+  const int nf = static_cast<int>(free_dof_.size());
+  K_free_.resize(nf, nf);
+  K_free_.setFromTriplets(triplets.begin(), triplets.end());
+  mass_free_.resize(nf);
+  for (int f = 0; f < nf; ++f) mass_free_[f] = mass_[free_dof_[static_cast<size_t>(f)] / 3];
+  if (cannula && cannula->enabled) cannula_.emplace(*cannula, boundary_nodes(needle.mesh()), mass_, step_ms_);
+
+  w_ = wd_ = wdd_ = load_ = cannula_load_ = Eigen::VectorXd::Zero(3 * n);
+  old_load_ = old_cannula_load_ = load_;
+  x_ = needle.mesh().X;
+  v_ = Eigen::MatrixX3d::Zero(n, 3);
+  update_state();
+  start_accelerations();
+}
+
+ImplicitNeedle::~ImplicitNeedle() = default;
+
+void ImplicitNeedle::update_state() {
+  const Eigen::RowVector3d d = (supports_.profile.displacement_mm(time_ms_) * supports_.direction).transpose();
+  const Eigen::RowVector3d s = (supports_.profile.velocity_mm_per_ms(time_ms_) * supports_.direction).transpose();
+  const Eigen::MatrixX3d& X = needle_.mesh().X;
+  for (Eigen::Index i = 0; i < X.rows(); ++i)
+    for (int k = 0; k < 3; ++k) {
+      x_(i, k) = X(i, k) + d[k] + w_[3 * i + k];
+      v_(i, k) = s[k] + wd_[3 * i + k];
+    }
+}
+
+void ImplicitNeedle::evaluate_loads(NeedleLoads& loads) {
+  external_.clear();
+  loads.needle_forces(x_, v_, time_ms_, external_);
+  load_.setZero();
+  for (const auto& [node, f] : external_) {
+    NEEDLE_REQUIRE(node >= 0 && node < x_.rows(), "external needle force on a node that does not exist");
+    load_.segment<3>(3 * node) += f;
+  }
+  cannula_load_.setZero();
+  if (cannula_) {
+    Eigen::MatrixX3d force = Eigen::MatrixX3d::Zero(x_.rows(), 3);
+    contact_ = cannula_->add_forces(x_, v_, force);
+    for (Eigen::Index i = 0; i < force.rows(); ++i) cannula_load_.segment<3>(3 * i) = force.row(i).transpose();
+  }
+  if (!load_.allFinite() || !cannula_load_.allFinite())
+    throw SolverError(fmt::format("the needle's loads became non-finite at t = {:.6g} ms", time_ms_));
+  if (contact_.max_penetration_mm > options_.max_penetration_mm)
+    throw SolverError(fmt::format("the needle passed the cannula's bore by {:.3g} mm at t = {:.6g} ms (limit {:.3g} mm): "
+                                  "runaway penetration", contact_.max_penetration_mm, time_ms_, options_.max_penetration_mm));
+}
+
+void ImplicitNeedle::apply_loads(NeedleLoads& loads) {
+  evaluate_loads(loads);
+  // The state at t = 0 is in equilibrium with these loads: they start the first step's trapezoid.
+  old_load_ = load_;
+  old_cannula_load_ = cannula_load_;
+  start_accelerations();
+}
+
+void ImplicitNeedle::start_accelerations() {
+  // M w'' = f - K w - M e d'' with the drive's acceleration over the first step.
+  const double h = step_ms_;
+  const double accel = (supports_.profile.velocity_mm_per_ms(time_ms_ + h) - supports_.profile.velocity_mm_per_ms(time_ms_)) / h;
+  const Eigen::VectorXd elastic = K_ * w_;
+  for (size_t f = 0; f < free_dof_.size(); ++f) {
+    const int d = free_dof_[f];
+    wdd_[d] = (load_[d] + cannula_load_[d] - elastic[d]) / mass_[d / 3] - accel * supports_.direction[d % 3];
+  }
+}
+
+ImplicitNeedle::Factor& ImplicitNeedle::factor_for(double dt) {
+  // A step within rounding of a factored one (time sums of whole steps) keeps its factor: the matrix differs
+  // by 1e-9 of its mass term at most.
+  for (size_t k = 0; k < factors_.size(); ++k)
+    if (std::abs(dt - factors_[k].first) <= 1e-9 * factors_[k].first) {
+      std::rotate(factors_.begin(), factors_.begin() + static_cast<std::ptrdiff_t>(k), factors_.begin() + static_cast<std::ptrdiff_t>(k) + 1);
+      return *factors_.front().second;
+    }
+  const auto start = std::chrono::steady_clock::now();
+  Eigen::SparseMatrix<double> A = K_free_;
+  for (Eigen::Index f = 0; f < A.rows(); ++f) A.coeffRef(f, f) += 4.0 / (dt * dt) * mass_free_[f];
+  auto factor = std::make_unique<Factor>();
+  factor->llt.compute(A.selfadjointView<Eigen::Lower>());
+  if (factor->llt.info() != Eigen::Success) throw SolverError("the implicit needle's step matrix could not be factored");
+  constexpr size_t kKept = 6;
+  if (factors_.size() == kKept) factors_.pop_back();
+  factors_.insert(factors_.begin(), {dt, std::move(factor)});
+  ++factorizations_;
+  factor_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return *factors_.front().second;
+}
+
+void ImplicitNeedle::advance_to(double end_time_ms, NeedleLoads& loads) {
+  while (time_ms_ < end_time_ms - 1e-12 * std::max(1.0, std::abs(end_time_ms))) step(std::min(step_ms_, end_time_ms - time_ms_), loads);
+}
+
+void ImplicitNeedle::step(double dt, NeedleLoads& loads) {
+  Factor& factor = factor_for(dt);
+  const double t0 = time_ms_, t1 = time_ms_ + dt;
+  const Eigen::Vector3d e = supports_.direction;
+  const double accel = (supports_.profile.velocity_mm_per_ms(t1) - supports_.profile.velocity_mm_per_ms(t0)) / dt;  // the drive's mean
+  const double drive_step = supports_.profile.displacement_mm(t1) - supports_.profile.displacement_mm(t0);
+  const Eigen::Vector3d momentum_before = momentum();
+  // The loads at the step's start, held over it (the contact's and the cannula's).
+  evaluate_loads(loads);
+
+  const Eigen::Index nf = static_cast<Eigen::Index>(free_dof_.size());
+  Eigen::VectorXd rhs(nf);
+  const double c0 = 4.0 / (dt * dt), c1 = 4.0 / dt;
+  for (Eigen::Index f = 0; f < nf; ++f) {
+    const int d = free_dof_[static_cast<size_t>(f)];
+    const double m = mass_free_[f];
+    rhs[f] = load_[d] + cannula_load_[d] - m * accel * e[d % 3] + m * (c0 * w_[d] + c1 * wd_[d] + wdd_[d]);
+  }
+  const Eigen::VectorXd w_free = factor.llt.solve(rhs);
+  if (!w_free.allFinite()) throw SolverError(fmt::format("the implicit needle's state became non-finite at t = {:.6g} ms", t1));
+  Eigen::VectorXd dw = Eigen::VectorXd::Zero(w_.size());
+  for (Eigen::Index f = 0; f < nf; ++f) {
+    const int d = free_dof_[static_cast<size_t>(f)];
+    const double wdd_new = c0 * (w_free[f] - w_[d] - dt * wd_[d]) - wdd_[d];
+    wd_[d] += 0.5 * dt * (wdd_[d] + wdd_new);
+    wdd_[d] = wdd_new;
+    dw[d] = w_free[f] - w_[d];
+    w_[d] = w_free[f];
+  }
+  time_ms_ = t1;
+  update_state();
+
+  // Work of the held loads over the step (trapezoid of the loads at the step's two ends, as Newmark's
+  // equilibrium at each end used them), through the absolute displacement.
+  double external_work = 0, cannula_work = 0;
+  for (Eigen::Index i = 0; i < x_.rows(); ++i) {
+    const Eigen::Vector3d dx = dw.segment<3>(3 * i) + drive_step * e;
+    external_work += 0.5 * (old_load_.segment<3>(3 * i) + load_.segment<3>(3 * i)).dot(dx);
+    cannula_work += 0.5 * (old_cannula_load_.segment<3>(3 * i) + cannula_load_.segment<3>(3 * i)).dot(dx);
+  }
+  // The supports' reaction from the needle's momentum balance (elastic forces sum to zero).
+  Eigen::Vector3d loads_sum = Eigen::Vector3d::Zero();
+  for (Eigen::Index i = 0; i < x_.rows(); ++i)
+    loads_sum += 0.5 * (old_load_.segment<3>(3 * i) + load_.segment<3>(3 * i) + old_cannula_load_.segment<3>(3 * i) + cannula_load_.segment<3>(3 * i));
+  drive_reaction_ = (momentum() - momentum_before) / dt - loads_sum;
+  drive_impulse_ += dt * drive_reaction_;
+  energy_.drive_work_mJ += drive_reaction_.dot(drive_step * e);
+  energy_.external_work_mJ += external_work;
+  energy_.cannula_work_mJ += cannula_work;
+  old_load_ = load_;
+  old_cannula_load_ = cannula_load_;
+  energy_.kinetic_mJ = 0.5 * mass_.dot(v_.rowwise().squaredNorm());
+  energy_.strain_mJ = 0.5 * w_.dot(K_ * w_);
+  ++steps_;
+  if (!std::isfinite(energy_.kinetic_mJ) || !std::isfinite(energy_.strain_mJ))
+    throw SolverError(fmt::format("the needle's energy became non-finite at t = {:.6g} ms", time_ms_));
+  const double work_scale = std::max({std::abs(energy_.drive_work_mJ), std::abs(energy_.cannula_work_mJ), std::abs(energy_.external_work_mJ)});
+  if (work_scale > 1e-6 && energy_.balance_error() > options_.max_energy_error)
+    throw SolverError(fmt::format("the needle's energy balance drifted by {:.3g} % at t = {:.6g} ms (limit {:.3g} %)",
+                                  100 * energy_.balance_error(), time_ms_, 100 * options_.max_energy_error));
+}
+
+void ImplicitNeedle::add_summary(nlohmann::json& summary) const {
+  summary["needle_time_step_ms"] = step_ms_;
+  summary["needle_factorizations"] = factorizations_;
+  summary["needle_factor_s"] = factor_s_;
+  summary["needle_free_dofs"] = free_dof_.size();
+  summary["needle_max_cannula_penetration_mm"] = contact_.max_penetration_mm;
+}
+
+}  // namespace needle
