@@ -182,6 +182,15 @@ StepReport TissueDynamics::finish_step(const std::vector<Vec3d>* external_force_
     body_work += p.mass_g[s] * body_acceleration_.dot(displacement[s]);
     acceleration_[s] = (p.force_N[s] + external_force_[s]) / p.mass_g[s] + body_acceleration_;
   }
+  // A particle an impulse moved between the halves: the first half's forces worked through the drift it
+  // had before (velocity Verlet's own account of its kinetic energy), the second half's through the whole.
+  for (const auto& [particle, shift] : impulse_shifts_) {
+    const size_t s = static_cast<size_t>(particle);
+    model_work -= 0.5 * (old_force[s] - old_external_force_[s]).dot(shift);
+    external_work -= 0.5 * old_external_force_[s].dot(shift);
+    body_work -= 0.5 * p.mass_g[s] * body_acceleration_.dot(shift);
+  }
+  impulse_shifts_.clear();
   energy_.model_work_mJ += model_work;
   energy_.body_work_mJ += body_work;
   energy_.external_work_mJ += external_work;
@@ -225,6 +234,7 @@ double TissueDynamics::apply_impulses(std::vector<std::pair<std::int32_t, Vec3d>
     v += dv;
     displacement_[s] += dt * dv;
     p.position_mm[s] += dt * dv;
+    impulse_shifts_.emplace_back(particle, dt * dv);
   }
   energy_.external_work_mJ += work;
   return work;

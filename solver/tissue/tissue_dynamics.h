@@ -68,7 +68,8 @@ class TissueDynamics {
   // Between the two halves, a kinematic contact's impulses (particle, J in g mm/ms): each particle's mid-step
   // velocity changes by J/m and its end position, through the drift, by dt J/m. Components the particle's
   // constraints hold (fixed, symmetry) are dropped from J, in place, so what is returned acted. Returns their
-  // work, J . (v_before + v_after) / 2 (the exact change of kinetic energy), booked as external work.
+  // work, J . (v_before + v_after) / 2 (the exact change of kinetic energy), booked as external work; the
+  // step's first-half forces are then booked through the drift before the impulse (velocity Verlet's account).
   double apply_impulses(std::vector<std::pair<std::int32_t, Vec3d>>& impulse_g_mm_per_ms);
   // Both halves with the external forces held.
   StepReport step(double max_dt_ms = std::numeric_limits<double>::infinity());
@@ -101,6 +102,7 @@ class TissueDynamics {
     double v_half_z;
   };
   std::vector<Landing> landed_;                 // this step's impacts on the plane
+  std::vector<std::pair<std::int32_t, Vec3d>> impulse_shifts_;  // this step's: particles moved by impulses, and by how much
   std::vector<std::int32_t> constrained_;      // particles with a constrained component
   std::vector<std::uint8_t> constrained_mask_;  // per particle: bit k = component k constrained
   // Step scratch, kept to avoid allocating per step.

@@ -10,6 +10,8 @@
 #include "geometry/grinding_recipe.h"
 #include "mesher/needle_mesher.h"
 #include "mesher/particle_lattice.h"
+#include "solver/contact/penalty_contact.h"
+#include "solver/contact/projection_contact.h"
 #include "solver/insertion/coupled_insertion.h"
 #include "solver/needle/needle_models.h"
 #include "solver/separation/needle_bond_cut.h"
@@ -333,4 +335,86 @@ TEST_CASE("A needle turned upside down deflects the other way by as much: the co
   CHECK(delta_down < -1e-3);
   CHECK(delta_up > 1e-3);
   CHECK(std::abs(delta_down + delta_up) < 0.03 * std::abs(delta_down));  // measured: 0.5 %
+}
+
+namespace {
+
+ContactOptions projection() {
+  ContactOptions c;
+  c.law = "projection";
+  return c;
+}
+
+}  // namespace
+
+TEST_CASE("Projection contact: a free block hit by the needle exchanges momentum exactly, at 5 times the penalty's step",
+          "[solver][lspg][gmsh]") {
+  // Free faces: only the drive and the z symmetry act from outside. The needle receives each step's impulse
+  // over the next step, so what it has not received yet (pending) closes the balance; the FE needle's first
+  // half kick of a step (the implicit needle's first trapezoid) still uses the last step's force, which
+  // leaves about half a needle step of it (bounded here by a whole one). The coupling step is the tissue's
+  // own, here 6 times what the penalty allows (stiffness factor 30, contact_courant 0.1).
+  const TetMesh mesh = small_needle(short_tip("SB", 6.0), true, 0.5);
+  const InsertionProfile profile = quick_profile(1.5);
+  for (const std::string model : {"fe", "implicit"}) {
+    const FeNeedle needle(mesh, NeedleMaterial{}, 0.0);
+    const ContactSurface surface(needle.mesh());
+    SpgTissue tissue(block(3.0, 1.6, 1.2, 0.4, false), TissueMaterial{}, SpgOptions{});
+    NeedleDynamicsOptions options;
+    options.implicit_step_ms = 0.25 * tissue.stable_time_step_ms();
+    const std::unique_ptr<NeedleModel> dynamics =
+        make_needle_model(model, {needle, driven_base_supports(needle.mesh(), profile, Eigen::Vector3d::UnitX()), std::nullopt, options});
+    CoupledInsertion run(*dynamics, tissue, surface, projection(), make_separation_models(SeparationOptions{}, surface), CouplingOptions{});
+    const double penalty_limit = PenaltyContact(surface, tissue.particles(), tissue.material(), ContactOptions{}).max_time_step_ms(0.1);
+    double shortest = 1e300;
+    int in_contact = 0;
+    while (run.time_ms() < profile.end_time_ms() - 1e-12) {
+      run.step(profile.end_time_ms());
+      if (run.time_ms() < profile.end_time_ms() - 1e-12) shortest = std::min(shortest, run.last_step_ms());
+      in_contact = std::max(in_contact, run.contact().particles_in_contact);
+    }
+    const auto& contact = dynamic_cast<const ProjectionContact&>(run.contact_model());
+    const Eigen::Vector3d tissue_p = run.tissue_momentum();
+    const Eigen::Vector3d balance = tissue_p + run.needle_momentum() - dynamics->drive_impulse_N_ms() + contact.pending_impulse();
+    const double lag = dynamics->time_step_ms() / run.last_step_ms() * contact.pending_impulse().norm();
+    INFO(model << ": shortest step " << shortest << " ms, penalty's " << penalty_limit << " ms; tissue momentum " << tissue_p.transpose()
+               << "; imbalance " << balance.transpose() << " (a needle step of the last force: " << lag << ")");
+    CHECK(in_contact > 0);
+    CHECK(tissue_p.x() > 0);
+    CHECK(shortest > 5 * penalty_limit);
+    CHECK(std::abs(balance.x()) <= lag + 1e-9 * tissue_p.norm());
+    CHECK(std::abs(balance.y()) <= lag + 1e-9 * tissue_p.norm());
+    // No particle inside the needle at the end: the run's own check after each step, and the level set's.
+    CHECK(run.max_particles_inside() == 0);
+    CHECK(run.contact_model().classify(tissue.particles(), dynamics->positions_mm()).particles_inside == 0);
+    CHECK(run.energy().balance_error() < 0.01);
+  }
+}
+
+TEST_CASE("Projection contact: a rigid needle into a block with fixed sides balances energy within 1 %, dissipation never negative",
+          "[solver][lspg][gmsh]") {
+  const TetMesh mesh = small_needle(short_tip("SB", 6.0), true, 0.5);
+  const InsertionProfile profile = quick_profile(2.0);
+  Insertion ins(mesh, 0.0, true, profile, Eigen::Vector3d::UnitX(), block(3.0, 1.6, 1.2, 0.4, true), CouplingOptions{}, projection());
+  ins.profile_end_ = profile.end_time_ms();
+  double least_dissipation = 0;
+  while (ins.run.time_ms() < profile.end_time_ms() - 1e-12) {
+    ins.run.step(profile.end_time_ms());
+    least_dissipation = std::min(least_dissipation, ins.run.energy().friction_dissipation_mJ);
+  }
+  const InsertionEnergy& e = ins.run.energy();
+  INFO("drive " << e.drive_work_mJ << " tissue internal " << e.tissue_internal_mJ << " tissue KE " << e.tissue_kinetic_mJ << " dissipated "
+                << e.friction_dissipation_mJ << " contact work " << e.contact_work_mJ << "; steps " << ins.run.steps());
+  // The tissue stored and dissipated some; the contact dissipated (an inelastic contact: each particle it
+  // meets loses its approach speed, where the penalty restitutes it; here, at 8 m/s into 0.4 mm particles held
+  // at the sides, that is several times the penalty's dissipation, in the paper's scene at 10 mm 17 % more:
+  // docs/notebook/measurements.md). It never went negative beyond 1 % of its end value: the lag of the
+  // needle's reaction creates almost nothing.
+  CHECK(e.tissue_internal_mJ > 0.01 * e.drive_work_mJ);
+  CHECK(e.friction_dissipation_mJ > 0.01 * e.drive_work_mJ);
+  CHECK(least_dissipation >= -0.01 * e.friction_dissipation_mJ);
+  CHECK(e.penalty_energy_mJ == 0);
+  CHECK(e.balance_error() < 0.01);
+  CHECK(ins.run.max_energy_error() < 0.01);
+  CHECK(ins.run.contact_model().classify(ins.tissue.particles(), ins.dynamics.positions_mm()).particles_inside == 0);
 }

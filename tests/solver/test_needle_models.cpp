@@ -53,7 +53,7 @@ TEST_CASE("Needle models are made by name; an unknown name lists the known ones"
     make_needle_model("beam", inputs);
     FAIL("an unknown model was made");
   } catch (const InputError& e) {
-    CHECK(std::string(e.what()) == "needle.model: unknown needle model 'beam' (known: fe, rigid)");
+    CHECK(std::string(e.what()) == "needle.model: unknown needle model 'beam' (known: fe, implicit, rigid)");
   }
 }
 
