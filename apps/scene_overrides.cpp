@@ -5,6 +5,7 @@
 #include <fmt/ranges.h>
 
 #include "core/input_error.h"
+#include "runs/model_levels.h"
 #include "solver/contact/needle_tissue_contact.h"
 
 namespace needle {
@@ -19,6 +20,7 @@ void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
     NEEDLE_REQUIRE(std::isnan(v) || (std::isfinite(v) && v >= 0), fmt::format("{} must be a number >= 0 (got {})", flag, v));
     return !std::isnan(v);
   };
+  if (!o.model.empty()) apply_model_level(scene, o.model);
   const bool travel_given = given(o.travel_mm, "--travel-mm"), speed_given = given(o.speed_m_per_s, "--speed-m-per-s");
   const bool decel_given = given_or_zero(o.decel_time_ms, "--decel-time-ms"), hold_given = given_or_zero(o.hold_ms, "--hold-ms");
   if (travel_given) scene.motion.travel_mm = o.travel_mm;
@@ -95,6 +97,9 @@ void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
 }
 
 void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
+  std::string levels;
+  for (const ModelLevel& level : model_levels()) levels += fmt::format("{}{}: {}", levels.empty() ? "" : "; ", level.name, level.description);
+  c->add_option("--model", o.model, fmt::format("The model level ({}; default: the scene's, the run defaults' full)", levels));
   c->add_option("--set", o.settings,
                 "Set any scene key, KEY=VALUE with the scene file's dotted names and units, e.g. --set tissue.material.nu=0.49 "
                 "--set 'motion.travel=10 mm' (docs/scenes.md); repeatable, applied after the other flags");
@@ -174,6 +179,7 @@ std::string scene_override_arguments(const SceneOverrides& o) {
   auto list = [&](const char* flag, const std::vector<double>& v) {
     if (!v.empty()) line += fmt::format(" {} {}", flag, fmt::join(v, ","));
   };
+  if (!o.model.empty()) line += fmt::format(" --model {}", o.model);
   for (const std::string& setting : o.settings) line += fmt::format(" --set '{}'", setting);
   number("--travel-mm", o.travel_mm);
   number("--spacing-mm", o.spacing_mm);

@@ -13,6 +13,7 @@ namespace needle {
 
 // The scene flags `needle run`, `paper` and `calibrate` share; NaN keeps the scene's value.
 struct SceneOverrides {
+  std::string model;  // the model level (runs/model_levels.h); empty: the scene's
   double travel_mm = std::nan(""), spacing_mm = std::nan(""), mesh_size_mm = std::nan("");
   int path_refinement = 0;  // 0: the scene's
   bool no_needle_cut = false;  // tissue separates by bond failure alone (the paper's model)
@@ -37,7 +38,7 @@ struct SceneOverrides {
 };
 // InputError naming the flag for a value that is not a positive number.
 void apply_scene_overrides(Scene& scene, const SceneOverrides& overrides);
-// The flags run, paper and calibrate share: --travel-mm, --spacing-mm, --path-refinement, --no-needle-cut, --tissue-nu,
+// The flags run, paper and calibrate share: --model, --travel-mm, --spacing-mm, --path-refinement, --no-needle-cut, --tissue-nu,
 // --tissue-friction, --tissue-law, --speed-m-per-s, --decel-time-ms, --hold-ms, --tissue-size-mm, --slit-half-height-mm, --relaxing-shear-fraction, --relaxation-time-ms, --cutting-pressure-mpa,
 // --crack-reach-mm, --crack-angles-deg, --crack-lead-mm, --groove-start-mm, --contact-skin-mm, --contact-stiffness-factor,
 // --tissue-entry-x-mm, and --set key=value for any scene key (each command

@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "runs/json_file.h"
+#include "runs/model_levels.h"
 #include "runs/run_driver.h"
 #include "runs/run_folder.h"
 #include "runs/scene_needle.h"
@@ -199,6 +200,7 @@ class InsertionRunModel : public RunModel {
  public:
   explicit InsertionRunModel(const Scene& scene) : scene_(scene) {
     NEEDLE_REQUIRE(scene.tissue.enabled, "run_insertion needs a scene with tissue.enabled");
+    check_model_combination(scene);
     const auto start = Clock::now();
     built_ = build_scene_needle(scene.needle);
     const bool mass_scaled = needle_model(scene.needle.model).mass_scaled;  // a rigid needle takes any step: no mass scaling
@@ -218,13 +220,9 @@ class InsertionRunModel : public RunModel {
     std::vector<std::unique_ptr<SeparationModel>> separations = make_separation_models(scene.tissue.separation, *surface_);
     setup_s_ = std::chrono::duration<double>(Clock::now() - start).count();
     NeedleDynamicsOptions dynamics = scene_dynamics_options(scene);
-    // The implicit needle's step by default: about a quarter of the tissue's stable step at the start, and a
-    // whole fraction of the history interval (the run lands on each record), so that every coupling step is a
-    // whole number of needle steps as the tissue's step drifts: one factorisation for the run.
-    if (dynamics.implicit_step_ms <= 0) {
-      const double interval = scene.output.history_interval_ms;
-      dynamics.implicit_step_ms = interval / std::ceil(interval / (0.25 * tissue_->stable_time_step_ms()));
-    }
+    // The implicit needle's longest step by default: the tissue's stable step at the start (it shrinks as the gel
+    // compresses), so that each coupling step is one needle step.
+    if (dynamics.implicit_step_ms <= 0) dynamics.implicit_step_ms = tissue_->stable_time_step_ms();
     needle_model_ = make_needle_model(scene.needle.model, {*needle_, driven_base_supports(needle_->mesh(), scene.motion, scene.direction),
                                                            scene.cannula.enabled ? std::optional<CannulaOptions>(scene.cannula) : std::nullopt,
                                                            dynamics});
@@ -240,6 +238,7 @@ class InsertionRunModel : public RunModel {
     return {fmt::format("needle {}: {} T{} elements, {} nodes, meshed in {:.2f} s{}", built_.name, built_.mesh.num_tets(),
                         built_.mesh.order == 2 ? 10 : 4, built_.mesh.num_nodes(), built_.mesh_seconds,
                         scene_.needle.model == "fe" ? "" : " (" + scene_.needle.model + ")"),
+            fmt::format("model {}: {} needle, {} contact", model_level_of(scene_), needle_model_->name(), run_->contact_model().law()),
             fmt::format("needle stable step {:.4g} ms (unscaled {:.4g} ms); added mass {:.3g} % in {} elements", n.stable_time_step_ms(),
                         n.unscaled_time_step_ms(), 100 * n.added_mass_g() / n.physical_mass_g(), n.mass_scaled_elements()),
             fmt::format("contact surface: {} triangles, level set {} voxels of {} mm ({:.1f} MiB) built in {:.2f} s", surface.num_triangles(),
@@ -271,6 +270,8 @@ class InsertionRunModel : public RunModel {
     const GrooveFill groove = run_groove_fill(*run_, built_, scene_);
     summary["needle_steps"] = run_->needle_steps();
     summary["needle_model"] = needle_model_->name();
+    summary["contact_law"] = run_->contact_model().law();
+    summary["model_level"] = model_level_of(scene_);
     summary["subcycling"] = scene_.solver.coupling.subcycling;
     summary["energy_mJ"] = {{"drive_work", e.drive_work_mJ}, {"tissue_internal", e.tissue_internal_mJ}, {"tissue_kinetic", e.tissue_kinetic_mJ},
                             {"needle_kinetic", e.needle_kinetic_mJ}, {"needle_strain", e.needle_strain_mJ}, {"contact_work", e.contact_work_mJ},

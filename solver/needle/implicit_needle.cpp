@@ -143,7 +143,11 @@ ImplicitNeedle::Factor& ImplicitNeedle::factor_for(double dt) {
 }
 
 void ImplicitNeedle::advance_to(double end_time_ms, NeedleLoads& loads) {
-  while (time_ms_ < end_time_ms - 1e-12 * std::max(1.0, std::abs(end_time_ms))) step(std::min(step_ms_, end_time_ms - time_ms_), loads);
+  // Equal steps of at most h (one step when the coupling step is at most h).
+  const double span = end_time_ms - time_ms_;
+  if (!(span > 1e-12 * std::max(1.0, std::abs(end_time_ms)))) return;
+  const long count = static_cast<long>(std::ceil(span / step_ms_ * (1 - 1e-12)));
+  for (long k = 0; k < count; ++k) step(k + 1 == count ? end_time_ms - time_ms_ : span / static_cast<double>(count), loads);
 }
 
 void ImplicitNeedle::step(double dt, NeedleLoads& loads) {

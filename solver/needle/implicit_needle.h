@@ -10,14 +10,16 @@
 // (the drive's acceleration is an inertial load on every free node). With the step h fixed,
 //   (K + 4 M / h^2) w(n+1) = f + M (4 / h^2 w(n) + 4 / h w'(n) + w''(n)),
 // unconditionally stable and free of numerical damping; the matrix is factored once per distinct step
-// (CHOLMOD) and kept (the coupled step takes whole needle steps, or a half, a quarter ... of one). The loads f (the tissue's contact and the cannula's penalty) are evaluated at the start of
+// (CHOLMOD) and the last six are kept: a kinematic contact's coupled step takes equal steps to each record
+// (coupled_insertion.h), so the steps repeat and a run factors a few times (the summary says how often).
+// A span longer than h is taken in equal steps of at most h. The loads f (the tissue's contact and the cannula's penalty) are evaluated at the start of
 // each step and held over it: a one-step lag. A kinematic contact's load is constant over a coupling step
 // anyway; the cannula's penalty is explicit, so its stiffness follows this step, k_i = scale m_i / h^2
 // (rigid_cannula.h): softer than at the explicit needle's step, which the run's cannula penetration reports.
 //
 // Errors against the explicit, geometrically nonlinear FE needle: small rotations (the paper's needles
 // turn by about 0.05 rad: a relative error of order 1e-3), and the period error of the trapezoidal rule,
-// (omega h)^2 / 12, about 1e-6 for the first bending mode at h = 1e-3 ms. Measured in the tests against the
+// (omega dt)^2 / 12, below 1e-5 for the first bending mode at the tissue's step (about 5e-3 ms at most). Measured in the tests against the
 // FE needle under a static and a dynamic tip load.
 // Energy: kinetic + strain (1/2 w.K w) = work of the drive's reaction (from the needle's momentum balance),
 // the cannula's and the external loads' (trapezoid of the held forces over each step); the run stops with

@@ -1,0 +1,43 @@
+#include "runs/model_levels.h"
+
+#include <fmt/format.h>
+
+#include "core/input_error.h"
+
+namespace needle {
+
+const std::vector<ModelLevel>& model_levels() {
+  static const std::vector<ModelLevel> levels = {
+      {"full", "fe", "penalty", "explicit FE needle subcycled in the tissue's step, frictional penalty contact (the reference)"},
+      {"projection", "fe", "projection", "explicit FE needle, kinematic contact: the tissue's own step"},
+      {"fast", "implicit", "projection", "implicit linear needle at the coupling step, kinematic contact: no subcycling"},
+  };
+  return levels;
+}
+
+void apply_model_level(Scene& scene, const std::string& name, const std::string& where) {
+  std::string known;
+  for (const ModelLevel& level : model_levels()) {
+    if (level.name == name) {
+      scene.needle.model = level.needle_model;
+      scene.tissue.contact.law = level.contact_law;
+      return;
+    }
+    known += (known.empty() ? "" : ", ") + level.name;
+  }
+  throw InputError(fmt::format("{}: unknown model level '{}' (known: {})", where, name, known));
+}
+
+std::string model_level_of(const Scene& scene) {
+  for (const ModelLevel& level : model_levels())
+    if (scene.needle.model == level.needle_model && scene.tissue.contact.law == level.contact_law) return level.name;
+  return "custom";
+}
+
+void check_model_combination(const Scene& scene) {
+  NEEDLE_REQUIRE(!(scene.needle.model == "implicit" && scene.tissue.contact.law == "penalty"),
+                 "needle.model implicit needs tissue.contact.law projection: the implicit needle holds its loads over its step, "
+                 "which a penalty's force does not allow (--model fast sets both)");
+}
+
+}  // namespace needle

@@ -1,0 +1,28 @@
+#pragma once
+// The insertion's model levels: named sets of the solver's speed-for-accuracy choices, so that a user (and
+// `needle bench`) can ask for "the fast model" or "the full model" without knowing the scene keys:
+//   full        the FE needle (explicit, subcycled) and the penalty contact: the reference, the paper's kind of model;
+//   projection  the FE needle and the kinematic contact: the contact no longer sets the step (one lever);
+//   fast        the implicit needle and the kinematic contact: no subcycling either (both levers).
+// Each level sets needle.model and tissue.contact.law; every other key stays the scene's. (The implicit needle
+// needs the kinematic contact: a penalty's force changes within a needle step.)
+#include <string>
+#include <vector>
+
+#include "runs/scene.h"
+
+namespace needle {
+
+struct ModelLevel {
+  std::string name, needle_model, contact_law, description;
+};
+
+const std::vector<ModelLevel>& model_levels();
+// Sets the level's keys; InputError naming where and the known levels for an unknown name.
+void apply_model_level(Scene& scene, const std::string& name, const std::string& where = "--model");
+// The level a scene's keys make, or "custom" (e.g. a rigid needle).
+std::string model_level_of(const Scene& scene);
+// InputError for a combination no level allows: the implicit needle with the penalty contact.
+void check_model_combination(const Scene& scene);
+
+}  // namespace needle
