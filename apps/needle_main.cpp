@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "apps/material_test_command.h"
+#include "apps/bench_command.h"
 #include "apps/calibrate_command.h"
 #include "apps/mesh_command.h"
 #include "apps/paper_command.h"
@@ -52,6 +53,7 @@ int main(int argc, char** argv) {
   needle::add_run_command(app);
   needle::add_paper_command(app);
   needle::add_calibrate_command(app);
+  needle::add_bench_command(app);
   for (CLI::App* command : app.get_subcommands({})) command->parse_complete_callback([command] { refuse_non_finite_numbers(*command); });
   try {
     app.parse(argc, argv);

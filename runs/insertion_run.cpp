@@ -220,9 +220,13 @@ class InsertionRunModel : public RunModel {
     std::vector<std::unique_ptr<SeparationModel>> separations = make_separation_models(scene.tissue.separation, *surface_);
     setup_s_ = std::chrono::duration<double>(Clock::now() - start).count();
     NeedleDynamicsOptions dynamics = scene_dynamics_options(scene);
-    // The implicit needle's longest step by default: the tissue's stable step at the start (it shrinks as the gel
-    // compresses), so that each coupling step is one needle step.
-    if (dynamics.implicit_step_ms <= 0) dynamics.implicit_step_ms = tissue_->stable_time_step_ms();
+    // The implicit needle's step by default: about a quarter of the tissue's stable step at the start, and a
+    // whole fraction of the history interval (the run lands on each record), so that the coupling steps are
+    // whole numbers of needle steps as the tissue's step shrinks (the gel compresses): few factorisations.
+    if (dynamics.implicit_step_ms <= 0) {
+      const double interval = scene.output.history_interval_ms;
+      dynamics.implicit_step_ms = interval / std::ceil(interval / (0.25 * tissue_->stable_time_step_ms()));
+    }
     needle_model_ = make_needle_model(scene.needle.model, {*needle_, driven_base_supports(needle_->mesh(), scene.motion, scene.direction),
                                                            scene.cannula.enabled ? std::optional<CannulaOptions>(scene.cannula) : std::nullopt,
                                                            dynamics});

@@ -77,14 +77,12 @@ double CoupledInsertion::plan_time_step(double end_time_ms) const {
   const double needle_dt = needle_.time_step_ms();
   if (!options_.subcycling) cap = std::min(cap, needle_dt);
   double dt = tissue_dynamics_.time_step_ms(cap);
-  // A law that leaves the step to the tissue takes equal steps to end_time_ms (the next record), so that the
-  // steps repeat (an implicit needle factors once per distinct step) and none is a sliver.
-  if (std::isinf(contact_->max_time_step_ms(options_.contact_courant))) {
-    const double span = end_time_ms - t;
-    dt = span / std::ceil(span / dt * (1 - 1e-12));
+  // A whole number of needle steps per coupling step, so that the needle never takes a sliver of a step; a
+  // coupling step shorter than the needle's is its half, quarter ... (an implicit needle keeps a factor for each).
+  if (std::isfinite(needle_dt) && dt < end_time_ms - t) {
+    if (dt > needle_dt) dt = std::floor(dt / needle_dt) * needle_dt;
+    else if (dt < needle_dt) dt = needle_dt / std::exp2(std::ceil(std::log2(needle_dt / dt)));
   }
-  // A whole number of needle steps per coupling step, so that the needle never takes a sliver of a step.
-  if (std::isfinite(needle_dt) && dt > needle_dt && dt < end_time_ms - t) dt = std::floor(dt / needle_dt) * needle_dt;
   return dt;
 }
 

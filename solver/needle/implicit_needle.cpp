@@ -14,6 +14,7 @@ namespace needle {
 
 struct ImplicitNeedle::Factor {
   Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>> llt;
+  std::unordered_map<int, Eigen::VectorXd> columns;  // A^-1 e_dof by dof, for the cannula's nodes
 };
 
 ImplicitNeedle::ImplicitNeedle(const FeNeedle& needle, NeedleSupports supports, const std::optional<CannulaOptions>& cannula,
@@ -57,7 +58,18 @@ ImplicitNeedle::ImplicitNeedle(const FeNeedle& needle, NeedleSupports supports, 
   K_free_.setFromTriplets(triplets.begin(), triplets.end());
   mass_free_.resize(nf);
   for (int f = 0; f < nf; ++f) mass_free_[f] = mass_[free_dof_[static_cast<size_t>(f)] / 3];
-  if (cannula && cannula->enabled) cannula_.emplace(*cannula, boundary_nodes(needle.mesh()), mass_, step_ms_);
+  free_index_ = index;
+  if (cannula && cannula->enabled) {
+    cannula->validate();
+    cannula_ = *cannula;
+    // As stiff as the explicit FE needle's cannula at its own step.
+    const double dt_fe = options_.courant * needle.stable_time_step_ms();
+    for (int node : boundary_nodes(needle.mesh())) {
+      cannula_nodes_.push_back(node);
+      cannula_k_.push_back(cannula->penalty_scale * mass_[node] / (dt_fe * dt_fe));
+    }
+  }
+  cannula_normal_N_ = Eigen::VectorXd::Zero(n);
 
   w_ = wd_ = wdd_ = load_ = cannula_load_ = Eigen::VectorXd::Zero(3 * n);
   old_load_ = old_cannula_load_ = load_;
@@ -88,17 +100,24 @@ void ImplicitNeedle::evaluate_loads(NeedleLoads& loads) {
     NEEDLE_REQUIRE(node >= 0 && node < x_.rows(), "external needle force on a node that does not exist");
     load_.segment<3>(3 * node) += f;
   }
+  // The cannula's friction, from the last step's normal forces, against each node's sliding.
   cannula_load_.setZero();
   if (cannula_) {
-    Eigen::MatrixX3d force = Eigen::MatrixX3d::Zero(x_.rows(), 3);
-    contact_ = cannula_->add_forces(x_, v_, force);
-    for (Eigen::Index i = 0; i < force.rows(); ++i) cannula_load_.segment<3>(3 * i) = force.row(i).transpose();
+    for (size_t k = 0; k < cannula_nodes_.size(); ++k) {
+      const int n = cannula_nodes_[k];
+      const double fn = cannula_normal_N_[n];
+      if (!(fn > 0) || cannula_->friction == 0) continue;
+      const double r = std::hypot(x_(n, 1), x_(n, 2));
+      if (r == 0) continue;
+      const Eigen::Vector3d radial(0, x_(n, 1) / r, x_(n, 2) / r);
+      const Eigen::Vector3d vel = v_.row(n).transpose();
+      const Eigen::Vector3d vt = vel - vel.dot(radial) * radial;
+      const double speed = vt.norm();
+      if (speed > 0) cannula_load_.segment<3>(3 * n) -= std::min(cannula_->friction * fn, 0.5 * mass_[n] / step_ms_ * speed) * vt / speed;
+    }
   }
   if (!load_.allFinite() || !cannula_load_.allFinite())
     throw SolverError(fmt::format("the needle's loads became non-finite at t = {:.6g} ms", time_ms_));
-  if (contact_.max_penetration_mm > options_.max_penetration_mm)
-    throw SolverError(fmt::format("the needle passed the cannula's bore by {:.3g} mm at t = {:.6g} ms (limit {:.3g} mm): "
-                                  "runaway penetration", contact_.max_penetration_mm, time_ms_, options_.max_penetration_mm));
 }
 
 void ImplicitNeedle::apply_loads(NeedleLoads& loads) {
@@ -168,7 +187,8 @@ void ImplicitNeedle::step(double dt, NeedleLoads& loads) {
     const double m = mass_free_[f];
     rhs[f] = load_[d] + cannula_load_[d] - m * accel * e[d % 3] + m * (c0 * w_[d] + c1 * wd_[d] + wdd_[d]);
   }
-  const Eigen::VectorXd w_free = factor.llt.solve(rhs);
+  Eigen::VectorXd w_free = factor.llt.solve(rhs);
+  if (cannula_) hold_in_cannula(factor, w_free, supports_.profile.displacement_mm(t1) * e);
   if (!w_free.allFinite()) throw SolverError(fmt::format("the implicit needle's state became non-finite at t = {:.6g} ms", t1));
   Eigen::VectorXd dw = Eigen::VectorXd::Zero(w_.size());
   for (Eigen::Index f = 0; f < nf; ++f) {
@@ -212,12 +232,124 @@ void ImplicitNeedle::step(double dt, NeedleLoads& loads) {
                                   100 * energy_.balance_error(), time_ms_, 100 * options_.max_energy_error));
 }
 
+const Eigen::VectorXd& ImplicitNeedle::column(Factor& factor, int dof) {
+  auto it = factor.columns.find(dof);
+  if (it != factor.columns.end()) return it->second;
+  Eigen::VectorXd unit = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(free_dof_.size()));
+  unit[free_index_[static_cast<size_t>(dof)]] = 1.0;
+  return factor.columns.emplace(dof, factor.llt.solve(unit)).first->second;
+}
+
+void ImplicitNeedle::hold_in_cannula(Factor& factor, Eigen::VectorXd& w, const Eigen::Vector3d& drive) {
+  const double r_in = cannula_->inner_radius_mm(), back = cannula_->front_x_mm - cannula_->length_mm, front = cannula_->front_x_mm;
+  const Eigen::MatrixX3d& X = needle_.mesh().X;
+  const Eigen::VectorXd w_free = w;  // without the cannula
+  // A node's position at t + dt for free components wf (held ones stay at X + d e).
+  const auto position = [&](int n, const Eigen::VectorXd& wf) {
+    Eigen::Vector3d p = X.row(n).transpose() + drive;
+    for (int k = 0; k < 3; ++k) {
+      const int f = free_index_[3 * static_cast<size_t>(n) + k];
+      if (f >= 0) p[k] += wf[f];
+    }
+    return p;
+  };
+  struct Spring {
+    int node;
+    double k;
+    Eigen::Vector3d normal;  // radial, outward, at the state it joined
+  };
+  const auto passes = [&](size_t k, const Eigen::VectorXd& wf) {
+    const Eigen::Vector3d p = position(cannula_nodes_[k], wf);
+    return p.x() >= back && p.x() <= front && std::hypot(p.y(), p.z()) > r_in;
+  };
+  const auto spring = [&](size_t k, const Eigen::VectorXd& wf) {
+    const Eigen::Vector3d p = position(cannula_nodes_[k], wf);
+    const double r = std::hypot(p.y(), p.z());
+    return Spring{cannula_nodes_[k], cannula_k_[k], Eigen::Vector3d(0, p.y() / r, p.z() / r)};
+  };
+  std::vector<Spring> active;
+  std::vector<std::uint8_t> tried(cannula_nodes_.size(), 0);
+  for (size_t k = 0; k < cannula_nodes_.size(); ++k)
+    if (passes(k, w_free)) {
+      active.push_back(spring(k, w_free));
+      tried[k] = 1;
+    }
+  Eigen::VectorXd solved = w_free;
+  for (int iteration = 0; iteration < 10 && !active.empty(); ++iteration) {
+    // Z = A^-1 U, U's column a = sqrt(k_a) n_a on node a's free components; the springs' constant part
+    // k (r - n.(X + d e)) n joins the right-hand side, as the sum of its A^-1 columns.
+    const Eigen::Index na = static_cast<Eigen::Index>(active.size()), nf = w_free.size();
+    Eigen::MatrixXd Z = Eigen::MatrixXd::Zero(nf, na);
+    Eigen::VectorXd shifted = w_free;
+    for (Eigen::Index a = 0; a < na; ++a) {
+      const Spring& s = active[static_cast<size_t>(a)];
+      const double offset = r_in - s.normal.dot(X.row(s.node).transpose() + drive);
+      for (int k = 1; k < 3; ++k) {
+        const int dof = 3 * s.node + k;
+        if (free_index_[static_cast<size_t>(dof)] < 0 || s.normal[k] == 0) continue;
+        const Eigen::VectorXd& c = column(factor, dof);
+        Z.col(a) += std::sqrt(s.k) * s.normal[k] * c;
+        shifted += s.k * offset * s.normal[k] * c;
+      }
+    }
+    const auto project = [&](const Eigen::VectorXd& v) {  // U^T v: sqrt(k_a) n_a . v on node a
+      Eigen::VectorXd out(na);
+      for (Eigen::Index a = 0; a < na; ++a) {
+        const Spring& s = active[static_cast<size_t>(a)];
+        double sum = 0;
+        for (int k = 1; k < 3; ++k) {
+          const int f = free_index_[3 * static_cast<size_t>(s.node) + k];
+          if (f >= 0) sum += s.normal[k] * v[f];
+        }
+        out[a] = std::sqrt(s.k) * sum;
+      }
+      return out;
+    };
+    Eigen::MatrixXd S = Eigen::MatrixXd::Identity(na, na);
+    for (Eigen::Index b = 0; b < na; ++b) S.col(b) += project(Z.col(b));
+    solved = shifted - Z * S.ldlt().solve(project(shifted));
+    // The set holds when no spring pulls and no node not yet tried passes the bore.
+    std::vector<Spring> next;
+    for (const Spring& s : active)
+      if (s.normal.dot(position(s.node, solved)) > r_in) next.push_back(s);
+    bool joined = false;
+    for (size_t k = 0; k < cannula_nodes_.size(); ++k)
+      if (!tried[k] && passes(k, solved)) {
+        next.push_back(spring(k, solved));
+        tried[k] = 1;
+        joined = true;
+      }
+    const bool same = !joined && next.size() == active.size();
+    active.swap(next);
+    if (same) break;
+  }
+  w = solved;
+  // The springs' forces at t + dt, and the report.
+  cannula_normal_N_.setZero();
+  contact_ = CannulaContact{};
+  for (const Spring& s : active) {
+    const double gap = s.normal.dot(position(s.node, w)) - r_in;
+    if (!(gap > 0)) continue;
+    const double fn = s.k * gap;
+    cannula_normal_N_[s.node] = fn;
+    cannula_load_.segment<3>(3 * s.node) -= fn * s.normal;
+    ++contact_.nodes_in_contact;
+    contact_.max_penetration_mm = std::max(contact_.max_penetration_mm, gap);
+    contact_.normal_force_N += fn;
+    contact_.force_N -= fn * s.normal;
+  }
+  max_cannula_penetration_mm_ = std::max(max_cannula_penetration_mm_, contact_.max_penetration_mm);
+  if (contact_.max_penetration_mm > options_.max_penetration_mm)
+    throw SolverError(fmt::format("the needle passed the cannula's bore by {:.3g} mm at t = {:.6g} ms (limit {:.3g} mm): "
+                                  "runaway penetration", contact_.max_penetration_mm, time_ms_, options_.max_penetration_mm));
+}
+
 void ImplicitNeedle::add_summary(nlohmann::json& summary) const {
   summary["needle_time_step_ms"] = step_ms_;
   summary["needle_factorizations"] = factorizations_;
   summary["needle_factor_s"] = factor_s_;
   summary["needle_free_dofs"] = free_dof_.size();
-  summary["needle_max_cannula_penetration_mm"] = contact_.max_penetration_mm;
+  summary["needle_max_cannula_penetration_mm"] = max_cannula_penetration_mm_;
 }
 
 }  // namespace needle

@@ -10,16 +10,21 @@
 // (the drive's acceleration is an inertial load on every free node). With the step h fixed,
 //   (K + 4 M / h^2) w(n+1) = f + M (4 / h^2 w(n) + 4 / h w'(n) + w''(n)),
 // unconditionally stable and free of numerical damping; the matrix is factored once per distinct step
-// (CHOLMOD) and the last six are kept: a kinematic contact's coupled step takes equal steps to each record
-// (coupled_insertion.h), so the steps repeat and a run factors a few times (the summary says how often).
-// A span longer than h is taken in equal steps of at most h. The loads f (the tissue's contact and the cannula's penalty) are evaluated at the start of
-// each step and held over it: a one-step lag. A kinematic contact's load is constant over a coupling step
-// anyway; the cannula's penalty is explicit, so its stiffness follows this step, k_i = scale m_i / h^2
-// (rigid_cannula.h): softer than at the explicit needle's step, which the run's cannula penetration reports.
+// (CHOLMOD) and the last six are kept: the coupled step takes whole needle steps, or a half, a quarter ...
+// of one when the tissue's step falls below it, so a run factors a few times (the summary says how often).
+// A span longer than h is taken in steps of h. The tissue's contact load is evaluated at the start of
+// each step and held over it (a kinematic contact's load is constant over a coupling step anyway).
+// The cannula (rigid_cannula.h: a tube of inner radius r along x) is implicit in its normal direction: a
+// surface node inside its length whose radius would pass r is held by a spring k_i = scale m_i / dt_FE^2 (the
+// FE needle's own cannula, dt_FE the explicit needle's step) along the radial n_i, linearised at the step's
+// predicted state: (A + sum k_i n_i n_i^T) w = b + sum k_i (r - n_i.(X_i + d e)) n_i, solved by the Woodbury
+// identity on the factor of A with the columns A^-1 e of the nodes in contact (cached per factor), the set
+// of nodes in contact iterated until it holds (a node that would pull leaves it, one that passes joins it).
+// Its Coulomb friction, min(mu f_n, m |v_t| / (2 h)), uses the last step's normal force and is held.
 //
 // Errors against the explicit, geometrically nonlinear FE needle: small rotations (the paper's needles
 // turn by about 0.05 rad: a relative error of order 1e-3), and the period error of the trapezoidal rule,
-// (omega dt)^2 / 12, below 1e-5 for the first bending mode at the tissue's step (about 5e-3 ms at most). Measured in the tests against the
+// (omega h)^2 / 12, about 1e-6 for the first bending mode at h = 1e-3 ms. Measured in the tests against the
 // FE needle under a static and a dynamic tip load.
 // Energy: kinetic + strain (1/2 w.K w) = work of the drive's reaction (from the needle's momentum balance),
 // the cannula's and the external loads' (trapezoid of the held forces over each step); the run stops with
@@ -61,6 +66,7 @@ class ImplicitNeedle : public NeedleModel {
   void add_summary(nlohmann::json& summary) const override;
 
   const CannulaContact& cannula_contact() const { return contact_; }
+  double max_cannula_penetration_mm() const { return max_cannula_penetration_mm_; }
   int factorizations() const { return factorizations_; }
   double factor_seconds() const { return factor_s_; }
 
@@ -68,8 +74,12 @@ class ImplicitNeedle : public NeedleModel {
   struct Factor;
   void step(double dt, NeedleLoads& loads);
   Factor& factor_for(double dt);  // the factored step matrix for dt, from the cache or new
-  // The held loads at the current state: contact (loads) + cannula, into f_ (3 per node) and the lists.
+  // The held loads at the current state: the contact's (loads) into load_, the cannula's friction into cannula_load_.
   void evaluate_loads(NeedleLoads& loads);
+  // The cannula's normal springs on the free components solved into w (free components), iterating the set of
+  // nodes in contact; their forces at t + dt are added to cannula_load_. drive_mm: d(t + dt) e.
+  void hold_in_cannula(Factor& factor, Eigen::VectorXd& w, const Eigen::Vector3d& drive_mm);
+  const Eigen::VectorXd& column(Factor& factor, int dof);  // A^-1 e_dof on the free components, cached
   void update_state();        // x_, v_ from w, w' and the drive
   void start_accelerations();  // w'' in equilibrium with the held loads at the current state
 
@@ -78,8 +88,13 @@ class ImplicitNeedle : public NeedleModel {
   NeedleDynamicsOptions options_;
   double step_ms_ = 0;
   Eigen::VectorXd mass_;
-  std::optional<RigidCannula> cannula_;
+  std::optional<CannulaOptions> cannula_;
+  std::vector<int> cannula_nodes_;         // surface nodes
+  std::vector<double> cannula_k_;          // per node: the normal spring (N/mm)
+  std::vector<int> free_index_;            // per component: its free index, -1 held
+  Eigen::VectorXd cannula_normal_N_;       // per node (all): the last step's normal force magnitude
   CannulaContact contact_;
+  double max_cannula_penetration_mm_ = 0;
   std::vector<int> free_dof_;              // free components, as 3 node + axis
   Eigen::SparseMatrix<double> K_;          // full stiffness (strain energy, reactions)
   Eigen::SparseMatrix<double> K_free_;     // on the free components, lower triangle

@@ -170,3 +170,51 @@ TEST_CASE("Implicit needle: driven at its base it moves with the drive and the d
   options.implicit_step_ms = 0;
   CHECK_THROWS_AS(ImplicitNeedle(fe, driven_base_supports(fe.mesh(), profile), std::nullopt, options), InputError);
 }
+
+TEST_CASE("Implicit needle: a rod pressed against the cannula's bore is held there as the explicit FE needle's cannula holds it",
+          "[solver][needle][gmsh]") {
+  // The base at x = -8 held, the cannula's front at x = -3 with 0.025 mm of clearance around the rod: a tip
+  // load of 6 N, ramped over 10 periods and held, presses the rod's bottom line onto the bore at the front.
+  const FeNeedle fe(rod(), NeedleMaterial{}, 0.0);
+  const NeedleSupports supports = driven_base_supports(fe.mesh(), held());
+  const double period_ms = 1e3 / ClampedNeedle(fe, supports.driven).lowest_modes(1).front().frequency_hz;
+  CannulaOptions cannula;
+  cannula.outer_diameter_mm = 1.1;
+  cannula.wall_mm = 0.025;
+  cannula.front_x_mm = -3.0;
+  cannula.length_mm = 10.0;
+  TipLoad load;
+  load.nodes = tip_nodes(fe.mesh());
+  load.total_N = 6.0;
+  load.ramp_ms = 10 * period_ms;
+  NeedleDynamicsOptions options;
+  options.implicit_step_ms = period_ms / 40;
+  ImplicitNeedle implicit(fe, supports, cannula, options);
+  NeedleDynamics explicit_fe(fe, supports, cannula, options);
+  implicit.apply_loads(load);
+  explicit_fe.apply_loads(load);
+  implicit.advance_to(load.ramp_ms, load);
+  explicit_fe.advance_to(load.ramp_ms, load);
+  double a = 0, b = 0, a_front = 0, b_front = 0;
+  int implicit_nodes = 0, explicit_nodes = 0;
+  const int front = nearest_node(fe.mesh(), Eigen::Vector3d(-3.0, -0.5, 0.0));
+  for (int k = 1; k <= 40; ++k) {  // the mean over one period
+    implicit.advance_to(load.ramp_ms + k * period_ms / 40, load);
+    explicit_fe.advance_to(load.ramp_ms + k * period_ms / 40, load);
+    implicit_nodes = std::max(implicit_nodes, implicit.cannula_contact().nodes_in_contact);
+    explicit_nodes = std::max(explicit_nodes, explicit_fe.cannula_contact().nodes_in_contact);
+    a += mean_tip_y(implicit, load.nodes) / 40;
+    b += mean_tip_y(explicit_fe, load.nodes) / 40;
+    a_front += implicit.displacements_mm()(front, 1) / 40;
+    b_front += explicit_fe.displacements_mm()(front, 1) / 40;
+  }
+  INFO("tip: implicit " << a << " mm, explicit " << b << " mm; at the cannula's front: " << a_front << ", " << b_front
+                        << " mm; cannula nodes " << implicit_nodes << " and " << explicit_nodes << ", the implicit's deepest "
+                        << implicit.max_cannula_penetration_mm() << " mm");
+  CHECK(implicit_nodes > 0);
+  CHECK(explicit_nodes > 0);
+  CHECK(a_front > -0.027);  // held at the bore, 0.025 mm below the rod's bottom line
+  CHECK(a == Approx(b).epsilon(0.02));
+  CHECK(a_front == Approx(b_front).epsilon(0.05));
+  CHECK(implicit.max_cannula_penetration_mm() < 1e-3);
+}
