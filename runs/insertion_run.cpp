@@ -220,12 +220,12 @@ class InsertionRunModel : public RunModel {
     std::vector<std::unique_ptr<SeparationModel>> separations = make_separation_models(scene.tissue.separation, *surface_);
     setup_s_ = std::chrono::duration<double>(Clock::now() - start).count();
     NeedleDynamicsOptions dynamics = scene_dynamics_options(scene);
-    // The implicit needle's step by default: about a quarter of the tissue's stable step at the start, and a
-    // whole fraction of the history interval (the run lands on each record), so that the coupling steps are
-    // whole numbers of needle steps as the tissue's step shrinks (the gel compresses): few factorisations.
+    // The implicit needle's step by default: about half the tissue's stable step at the start, a whole fraction
+    // of the history interval (the run lands on each record); the coupling steps are whole eighths of it as the
+    // tissue's step shrinks (the gel compresses), so the needle factors a few times a run.
     if (dynamics.implicit_step_ms <= 0) {
       const double interval = scene.output.history_interval_ms;
-      dynamics.implicit_step_ms = interval / std::ceil(interval / (0.25 * tissue_->stable_time_step_ms()));
+      dynamics.implicit_step_ms = interval / std::ceil(interval / (0.5 * tissue_->stable_time_step_ms()));
     }
     needle_model_ = make_needle_model(scene.needle.model, {*needle_, driven_base_supports(needle_->mesh(), scene.motion, scene.direction),
                                                            scene.cannula.enabled ? std::optional<CannulaOptions>(scene.cannula) : std::nullopt,

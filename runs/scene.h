@@ -57,7 +57,7 @@ struct SolverScene {
   double mass_scaling_dt_ms = 0.0;  // 0: off
   double max_energy_error = 0.05;
   double max_penetration_mm = 0.05;
-  double implicit_needle_step_ms = 0.0;  // the implicit needle's step (needle.model implicit); 0: about a quarter of the tissue's first stable step
+  double implicit_needle_step_ms = 0.0;  // the implicit needle's step (needle.model implicit); 0: about half the tissue's first stable step
   int threads = 0;
   CouplingOptions coupling;  // subcycling, step caps, the insertion's stop criteria
 };

@@ -74,14 +74,14 @@ double CoupledInsertion::plan_time_step(double end_time_ms) const {
   NEEDLE_REQUIRE(cap > 0, "the insertion has reached its end time");
   if (options_.max_step_ms > 0) cap = std::min(cap, options_.max_step_ms);
   cap = std::min(cap, contact_->max_time_step_ms(options_.contact_courant));
-  const double needle_dt = needle_.time_step_ms();
+  const double needle_dt = needle_.time_step_ms(), grid = needle_.step_grid_ms();
   if (!options_.subcycling) cap = std::min(cap, needle_dt);
   double dt = tissue_dynamics_.time_step_ms(cap);
-  // A whole number of needle steps per coupling step, so that the needle never takes a sliver of a step; a
-  // coupling step shorter than the needle's is its half, quarter ... (an implicit needle keeps a factor for each).
-  if (std::isfinite(needle_dt) && dt < end_time_ms - t) {
-    if (dt > needle_dt) dt = std::floor(dt / needle_dt) * needle_dt;
-    else if (dt < needle_dt) dt = needle_dt / std::exp2(std::ceil(std::log2(needle_dt / dt)));
+  // A whole number of the needle's grid per coupling step, so that the needle never takes a sliver of a step
+  // (below one grid step: its half, quarter ...).
+  if (std::isfinite(grid) && dt < end_time_ms - t) {
+    if (dt > grid) dt = std::floor(dt / grid) * grid;
+    else if (dt < grid) dt = grid / std::exp2(std::ceil(std::log2(grid / dt)));
   }
   return dt;
 }

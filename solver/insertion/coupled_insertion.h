@@ -3,13 +3,13 @@
 // the SPG tissue (tissue/spg_tissue.h, tissue/tissue_dynamics.h) through the frictional penalty contact
 // (contact/needle_tissue_contact.h), the tissue separated after each step by the scene's separation models
 // (separation/separation_models.h), in one explicit run with two clocks. The coupled step, as step() reads:
-//   1. plan dt: the tissue's stable step, capped by the contact's (contact_courant of its own limit) and
-//      the end time, rounded down to whole needle steps;
+//   1. plan dt: the tissue's stable step, capped by the contact law's limit (the penalty's: contact_courant of
+//      its own; a kinematic law has none) and the end time, cut to a whole number of the needle's step grid;
 //   2. the tissue's first half of velocity Verlet: half kick and drift to its end positions;
 //   3. the contact begins the step: geometry from both bodies (particles at their end, needle at its start);
 //   4. the needle advances to t + dt under the contact's loads, subcycling at its own step (the contact's
 //      gap is updated from both bodies' motion at every needle step);
-//   5. the contact ends the step: its force at t + dt on the particles;
+//   5. the contact ends the step: its force at t + dt on the particles (penalty) or its impulses (projection);
 //   6. the tissue's second half: its forces at t + dt with the contact's, the half kick;
 //   7. each separation model separates the tissue (the needle's cut, the slit, the crack);
 //   8. the energy account, penetration and drift checks (each body checks its own NaN and blow-up).

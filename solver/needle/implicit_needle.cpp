@@ -153,7 +153,7 @@ ImplicitNeedle::Factor& ImplicitNeedle::factor_for(double dt) {
   auto factor = std::make_unique<Factor>();
   factor->llt.compute(A.selfadjointView<Eigen::Lower>());
   if (factor->llt.info() != Eigen::Success) throw SolverError("the implicit needle's step matrix could not be factored");
-  constexpr size_t kKept = 6;
+  constexpr size_t kKept = 10;
   if (factors_.size() == kKept) factors_.pop_back();
   factors_.insert(factors_.begin(), {dt, std::move(factor)});
   ++factorizations_;
@@ -162,11 +162,9 @@ ImplicitNeedle::Factor& ImplicitNeedle::factor_for(double dt) {
 }
 
 void ImplicitNeedle::advance_to(double end_time_ms, NeedleLoads& loads) {
-  // Equal steps of at most h (one step when the coupling step is at most h).
-  const double span = end_time_ms - time_ms_;
-  if (!(span > 1e-12 * std::max(1.0, std::abs(end_time_ms)))) return;
-  const long count = static_cast<long>(std::ceil(span / step_ms_ * (1 - 1e-12)));
-  for (long k = 0; k < count; ++k) step(k + 1 == count ? end_time_ms - time_ms_ : span / static_cast<double>(count), loads);
+  // Steps of h, then the remainder (a whole number of grid steps when the coupled step plans it).
+  const double tolerance = 1e-9 * step_ms_;
+  while (end_time_ms - time_ms_ > tolerance) step(end_time_ms - time_ms_ > step_ms_ + tolerance ? step_ms_ : end_time_ms - time_ms_, loads);
 }
 
 void ImplicitNeedle::step(double dt, NeedleLoads& loads) {

@@ -10,9 +10,9 @@
 // (the drive's acceleration is an inertial load on every free node). With the step h fixed,
 //   (K + 4 M / h^2) w(n+1) = f + M (4 / h^2 w(n) + 4 / h w'(n) + w''(n)),
 // unconditionally stable and free of numerical damping; the matrix is factored once per distinct step
-// (CHOLMOD) and the last six are kept: the coupled step takes whole needle steps, or a half, a quarter ...
-// of one when the tissue's step falls below it, so a run factors a few times (the summary says how often).
-// A span longer than h is taken in steps of h. The tissue's contact load is evaluated at the start of
+// (CHOLMOD) and the last ten are kept: a span is taken in steps of h and one remainder, and the coupled step
+// is a whole number of eighths of h (step_grid_ms), so a run factors at most nine times (the summary says how
+// often). The tissue's contact load is evaluated at the start of
 // each step and held over it (a kinematic contact's load is constant over a coupling step anyway).
 // The cannula (rigid_cannula.h: a tube of inner radius r along x) is implicit in its normal direction: a
 // surface node inside its length whose radius would pass r is held by a spring k_i = scale m_i / dt_FE^2 (the
@@ -50,6 +50,8 @@ class ImplicitNeedle : public NeedleModel {
   const TetMesh& mesh() const override { return needle_.mesh(); }
   const Eigen::VectorXd& nodal_mass_g() const override { return mass_; }
   double time_step_ms() const override { return step_ms_; }
+  // An eighth of its step: a span is taken in steps of h and one remainder, a whole number of eighths.
+  double step_grid_ms() const override { return step_ms_ / 8; }
   void apply_loads(NeedleLoads& loads) override;
   void advance_to(double end_time_ms, NeedleLoads& loads) override;
 

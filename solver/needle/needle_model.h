@@ -46,6 +46,9 @@ class NeedleModel {
   virtual const Eigen::VectorXd& nodal_mass_g() const = 0;
   // Its own stable step; infinity when any step is stable (the rigid needle).
   virtual double time_step_ms() const = 0;
+  // The grid a coupling step is cut to (a whole number of it), so that the model never takes a sliver of a
+  // step: its own step for an explicit model; an implicit one takes any multiple of a finer grid.
+  virtual double step_grid_ms() const { return time_step_ms(); }
 
   // The loads at the current state join the forces that start the next step (call once, at t = 0).
   virtual void apply_loads(NeedleLoads& loads) = 0;
