@@ -17,6 +17,12 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 std::string csv_number(double v) { return std::isfinite(v) ? fmt::format("{}", v) : ""; }
+// A text field without the characters that would split or quote it.
+std::string csv_text(std::string text) {
+  for (char& c : text)
+    if (c == ',' || c == '"' || c == '\n') c = ';';
+  return text;
+}
 nlohmann::json json_number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
 }  // namespace
@@ -68,9 +74,10 @@ void write_speed_error_report(const std::vector<SpeedErrorCase>& cases, const st
     f << "needle,level,runtime_s,coupling_steps,needle_steps,deflection_mm,error_vs_reference_mm,error_vs_full_mm,max_penetration_mm,"
          "max_particles_inside,max_energy_balance_error,status,reason\n";
     for (const SpeedErrorCase& c : cases)
-      f << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},\"{}\"\n", c.needle, c.level, csv_number(c.runtime_s), c.coupling_steps,
+      f << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{}\n", c.needle, c.level, csv_number(c.runtime_s), c.coupling_steps,
                        c.needle_steps, csv_number(c.deflection_mm), csv_number(c.error_vs_reference_mm), csv_number(c.error_vs_full_mm),
-                       csv_number(c.max_penetration_mm), c.max_particles_inside, csv_number(c.max_energy_balance_error), c.status, c.reason);
+                       csv_number(c.max_penetration_mm), c.max_particles_inside, csv_number(c.max_energy_balance_error), c.status,
+                       csv_text(c.reason));
   });
   nlohmann::json j = {{"reference", reference_source}, {"cases", nlohmann::json::array()}};
   for (const SpeedErrorCase& c : cases)

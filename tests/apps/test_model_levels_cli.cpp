@@ -1,0 +1,81 @@
+// The model levels on the command line (runs/model_levels.h): --model sets the needle model and the contact law
+// together, a wrong name or combination is refused with nothing written; `needle bench insertion` runs each level
+// on one scene and writes the speed-against-error table from the runs' own summaries.
+#include <catch2/catch.hpp>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "cli_run.h"
+#include "run_fixtures.h"
+#include "runs/csv_table.h"
+
+namespace fs = std::filesystem;
+using namespace needle_test;
+
+TEST_CASE("needle run --model fast runs the implicit needle with the kinematic contact; bad levels are refused", "[apps][lspg][gmsh]") {
+  const RunFiles fast = run_sb_into_small_block("model_fast", "--model fast");
+  CHECK(fast.scene["needle"]["model"] == "implicit");
+  CHECK(fast.scene["tissue"]["contact"]["law"] == "projection");
+  CHECK(fast.summary["model_level"] == "fast");
+  CHECK(fast.summary["status"] == "finished");
+  CHECK(fast.summary["needle_factorizations"].get<int>() >= 1);
+  CHECK(fast.summary["particles_inside"].get<int>() == 0);
+  // One needle step or a few per coupling step, where the explicit needle takes hundreds.
+  CHECK(fast.summary["needle_steps"].get<long>() < 4 * fast.summary["steps"].get<long>());
+  const RunFiles full = run_sb_into_small_block("model_full", "--model full");
+  CHECK(full.summary["model_level"] == "full");
+  CHECK(full.summary["needle_steps"].get<long>() > 20 * full.summary["steps"].get<long>());
+  CHECK(full.summary["steps"].get<long>() > 2 * fast.summary["steps"].get<long>());
+  refused_on_small_block("model_bad", "--model quick", "--model: unknown model level 'quick' (known: full, projection, fast)");
+  refused_on_small_block("model_mixed", "--set needle.model=implicit", "needle.model implicit needs tissue.contact.law projection");
+  refused_on_small_block("model_law", "--set tissue.contact.law=spring", "law: must be penalty or projection (got 'spring')");
+}
+
+TEST_CASE("needle bench insertion writes one row per needle and level from the runs, reuses finished ones, refuses bad lists",
+          "[apps][lspg][gmsh]") {
+  const fs::path dir = fresh_folder("bench_insertion");
+  write(dir / "scene.json", R"({"needle": {"preset": "SB", "length_mm": 26, "mesh": {"order": 1, "size_mm": 0.5}},)"
+                            R"("motion": {"accel_time_ms": 0.02, "travel_mm": 0.8}, "cannula": {"enabled": false},)"
+                            R"("tissue": {"enabled": true, "size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4}, "output": {"frames": 0}})");
+  write(dir / "reference.json", R"({"travel_mm": 0.8, "deflection_mm": {"SB": -0.001}})");
+  const std::string args = "bench insertion --scene " + (dir / "scene.json").string() + " --reference " + (dir / "reference.json").string() +
+                           " --needles SB --levels projection,fast --out " + (dir / "out").string();
+  const Result r = run(args, true);
+  INFO(r.out);
+  REQUIRE(r.exit_code == 0);
+  const needle::CsvTable table = needle::read_csv_table((dir / "out" / "speed_error.csv").string());
+  REQUIRE(table.rows.size() == 2);
+  for (int k = 0; k < 2; ++k) {
+    const fs::path run_dir = dir / "out" / (k == 0 ? "SB_projection" : "SB_fast");
+    std::ifstream in(run_dir / "summary.json");
+    const nlohmann::json summary = nlohmann::json::parse(in);
+    // The table's numbers are the run's own, the error its deflection minus the reference's.
+    CHECK(table.column("deflection_mm")[static_cast<size_t>(k)] == Approx(summary["deflection_mm"].get<double>()).epsilon(1e-12));
+    CHECK(table.column("error_vs_reference_mm")[static_cast<size_t>(k)] == Approx(summary["deflection_mm"].get<double>() + 0.001).epsilon(1e-9));
+    CHECK(table.column("coupling_steps")[static_cast<size_t>(k)] == summary["steps"].get<double>());
+  }
+  CHECK(fs::exists(dir / "out" / "speed_error.png"));
+  CHECK(fs::exists(dir / "out" / "speed_error.json"));
+  // Again: both runs are reused, the table is the same.
+  const Result again = run(args, true);
+  CHECK(again.exit_code == 0);
+  CHECK(again.out.find("reused") != std::string::npos);
+  CHECK(needle::read_csv_table((dir / "out" / "speed_error.csv").string()).rows.size() == 2);
+  // Bad lists and a reference of another travel are refused before any run.
+  for (const auto& [flags, message] : {std::pair<std::string, std::string>{"--levels quick", "--levels: unknown model level 'quick'"},
+                                       {"--needles ,", "--needles: give at least one needle"}}) {
+    const Result bad = run("bench insertion --scene " + (dir / "scene.json").string() + " --reference '' " + flags + " --out " +
+                               (dir / "bad").string(), true);
+    INFO(flags << ": " << bad.out);
+    CHECK(bad.exit_code == 2);
+    CHECK(bad.out.find(message) != std::string::npos);
+    CHECK(!fs::exists(dir / "bad"));
+  }
+  write(dir / "far.json", R"({"travel_mm": 10, "deflection_mm": {"SB": -0.2}})");
+  const Result far = run("bench insertion --scene " + (dir / "scene.json").string() + " --reference " + (dir / "far.json").string() +
+                             " --out " + (dir / "far").string(), true);
+  CHECK(far.exit_code == 2);
+  CHECK(far.out.find("was run to 10 mm, the scene goes 0.8 mm") != std::string::npos);
+  CHECK(!fs::exists(dir / "far"));
+}
