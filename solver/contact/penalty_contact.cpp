@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "core/input_error.h"
+#include "core/parallel.h"
 
 namespace needle {
 
@@ -32,12 +33,14 @@ void PenaltyContact::begin_step(const TissueParticles& particles, const Eigen::M
   for (int node : surface_.nodes()) needle_speed = std::max(needle_speed, needle_v.row(node).norm());
   std::vector<Vec3d> start(n);
   std::vector<double> reach(n);
-  for (size_t i = 0; i < n; ++i) {
-    const Vec3d& v = particles.velocity_mm_per_ms[i];
-    start[i] = particles.position_mm[i] - dt_ms * v;
-    // Whatever can close the gap within the step, with room to spare.
-    reach[i] = 1.5 * dt_ms * (v.norm() + needle_speed) + 0.25 * options_.skin_mm;
-  }
+  parallel_for(static_cast<std::int64_t>(n), [&](std::int64_t begin, std::int64_t end) {
+    for (size_t i = static_cast<size_t>(begin); i < static_cast<size_t>(end); ++i) {
+      const Vec3d& v = particles.velocity_mm_per_ms[i];
+      start[i] = particles.position_mm[i] - dt_ms * v;
+      // Whatever can close the gap within the step, with room to spare.
+      reach[i] = 1.5 * dt_ms * (v.norm() + needle_speed) + 0.25 * options_.skin_mm;
+    }
+  });
   probe(start, needle_x, reach);
   pairs_.clear();
   report_.particles_inside = 0;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
+#include <mutex>
 #include <unordered_set>
 
 #include "core/input_error.h"
@@ -332,14 +333,23 @@ void SpgTissue::reset_material_state(size_t s) {
 
 double SpgTissue::stable_time_step_ms() const {
   const double factor = options_.stabilization == Stabilization::penalty ? 1.0 + 4.0 * options_.stabilization_coefficient : 1.0;
+  // The shortest support's current length and the stiffest point of a stiffening law, per chunk in parallel and
+  // then over the chunks (min and max are exact in any order).
+  std::mutex merge;
   double shortest = std::numeric_limits<double>::infinity();  // current length of the shortest support
   double largest_strain = 0;  // the stiffest point of a stiffening law
-  for (std::int64_t i = 0; i < p_.size(); ++i) {
-    const size_t s = static_cast<size_t>(i);
-    if (!rk_.valid[s]) continue;
-    shortest = std::min(shortest, stable_length_mm_[s] * min_stretch_[s]);
-    largest_strain = std::max(largest_strain, p_.effective_strain[s] - p_.plastic_strain[s]);
-  }
+  parallel_for(p_.size(), [&](std::int64_t begin, std::int64_t end) {
+    double chunk_shortest = std::numeric_limits<double>::infinity(), chunk_strain = 0;
+    for (std::int64_t i = begin; i < end; ++i) {
+      const size_t s = static_cast<size_t>(i);
+      if (!rk_.valid[s]) continue;
+      chunk_shortest = std::min(chunk_shortest, stable_length_mm_[s] * min_stretch_[s]);
+      chunk_strain = std::max(chunk_strain, p_.effective_strain[s] - p_.plastic_strain[s]);
+    }
+    const std::lock_guard<std::mutex> lock(merge);
+    shortest = std::min(shortest, chunk_shortest);
+    largest_strain = std::max(largest_strain, chunk_strain);
+  });
   const double wave_speed = std::sqrt(material_.tangent_p_wave_modulus_MPa(largest_strain) * factor / material_.density_g_per_mm3());
   return options_.cfl * shortest / wave_speed;
 }

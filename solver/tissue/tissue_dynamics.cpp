@@ -94,6 +94,12 @@ void TissueDynamics::apply_constraints(std::vector<Vec3d>& v, double time_ms, do
   }
 }
 
+void TissueDynamics::half_kick(std::vector<Vec3d>& v, double dt) const {
+  parallel_for(static_cast<std::int64_t>(v.size()), [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t i = begin; i < end; ++i) v[static_cast<size_t>(i)] += (0.5 * dt) * acceleration_[static_cast<size_t>(i)];
+  });
+}
+
 double TissueDynamics::kinetic_energy_mJ() const {
   const TissueParticles& p = tissue_.particles();
   double ke = 0;
@@ -133,11 +139,13 @@ double TissueDynamics::kick_and_drift(double max_dt_ms) {
   // Half kick, constraints, drift.
   for (size_t k = 0; k < constrained_.size(); ++k) constrained_velocity_before_[k] = p.velocity_mm_per_ms[static_cast<size_t>(constrained_[k])];
   std::vector<Vec3d>& v = p.velocity_mm_per_ms;
-  for (std::int64_t i = 0; i < n; ++i) v[static_cast<size_t>(i)] += (0.5 * dt) * acceleration_[static_cast<size_t>(i)];
+  half_kick(v, dt);
   apply_constraints(v, time_ms_ + 0.5 * dt, dt);
   for (size_t k = 0; k < constrained_.size(); ++k) constrained_velocity_half_[k] = p.velocity_mm_per_ms[static_cast<size_t>(constrained_[k])];
-  old_force_ = p.force_N;
-  for (std::int64_t i = 0; i < n; ++i) old_force_[static_cast<size_t>(i)] += external_force_[static_cast<size_t>(i)];
+  old_force_.resize(static_cast<size_t>(n));
+  parallel_for(n, [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t i = begin; i < end; ++i) old_force_[static_cast<size_t>(i)] = p.force_N[static_cast<size_t>(i)] + external_force_[static_cast<size_t>(i)];
+  });
   parallel_for(n, [&](std::int64_t begin, std::int64_t end) {
     for (std::int64_t i = begin; i < end; ++i) {
       displacement_[static_cast<size_t>(i)] = dt * p.velocity_mm_per_ms[static_cast<size_t>(i)];
@@ -195,7 +203,7 @@ StepReport TissueDynamics::finish_step(const std::vector<Vec3d>* external_force_
   energy_.body_work_mJ += body_work;
   energy_.external_work_mJ += external_work;
   std::vector<Vec3d>& v = p.velocity_mm_per_ms;
-  for (std::int64_t i = 0; i < n; ++i) v[static_cast<size_t>(i)] += (0.5 * dt) * acceleration_[static_cast<size_t>(i)];
+  half_kick(v, dt);
   apply_constraints(v, time_ms_, 0.0);
   // Reactions on constrained components: R = m dv/dt - f over the step, working through the displacement.
   double constraint_work = 0;

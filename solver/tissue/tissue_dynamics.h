@@ -87,6 +87,7 @@ class TissueDynamics {
   // carrying it below z = 0 (it lands on the plane); 0 after the drift.
   void apply_constraints(std::vector<Vec3d>& v, double time_ms, double drift_dt_ms);
   double kinetic_energy_mJ() const;
+  void half_kick(std::vector<Vec3d>& v, double dt) const;  // v += dt/2 a, per particle (in parallel)
 
   SpgTissue& tissue_;
   std::vector<VelocityConstraint> constraints_;
