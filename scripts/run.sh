@@ -24,12 +24,18 @@ done
 ./build/bench/bench_spg | tee out/bench_spg.txt
 ./build/bench/bench_needle | tee out/bench_needle.txt
 ./build/bench/bench_insertion | tee out/bench_insertion.txt
+# Speed against error of the fast model level, SB and AMB 10 mm into the bench scene, against the stored reference
+# (a few minutes; the full and projection levels' runs, about 20 and 7 min a needle, are stored in
+# docs/notebook/paper_results/bench_insertion_10mm/: `needle bench insertion --out DIR` runs all three).
+./build/apps/needle bench insertion --levels fast --out out/bench_levels --quiet
+cat out/bench_levels/speed_error.csv
 # The paper reproduced: SB, LMB, AMB and HMB on the paper's scene with the tissue E calibrated on SB
 # (data/paper/calibration_sb.json, made by `needle calibrate`; docs/paper.md), about 20–40 minutes a needle
 # on 2 cores. A run the solver stops is reported as such in the report, not an error of the main job.
-# The report sets five other models beside it, from their stored reports in docs/notebook/paper_results/: the
+# The report sets six other models beside it, from their stored reports in docs/notebook/paper_results/: the
 # contact's former default (skin 0.04 mm, factor 10), skin 0.02 mm at factor 10, the groove 5 mm behind
-# the tip point, the tissue law that stiffens as the paper's measured curve, and no cut (docs/paper.md). Two replicas
+# the tip point, the tissue law that stiffens as the paper's measured curve, no cut, and the fast model level
+# (the kinematic contact and the implicit needle, at the same E; docs/insertion.md) (docs/paper.md). Two replicas
 # of the default model, its runs repeated with the particle lattice shifted 0.1 and 0.05 mm against the needle's path
 # (docs/notebook/scripts/scatter_study.sh), give each deflection's run-to-run scatter and the targets that hold in every replica.
 ./build/apps/needle paper --calibration data/paper/calibration_sb.json --out out/paper --label "cut, 0.2 mm near the path, skin 0.02 mm" \
@@ -38,10 +44,12 @@ done
   --compare "groove 5 mm behind A, skin 0.04 mm, calibrated (E 0.0493)=docs/notebook/paper_results/groove5_calibrated/results.json" \
   --compare "stiffening law, skin 0.04 mm, calibrated on SB=docs/notebook/paper_results/stiffening_calibrated/results.json" \
   --compare "no cut, skin 0.04 mm, E 0.0748=docs/notebook/paper_results/no_cut/results.json" \
+  --compare "the fast model (--model fast), E 0.078=docs/notebook/paper_results/fast_model/results.json" \
   --replica "lattice +0.1 mm=docs/notebook/paper_results/lattice_shift_0.1mm/results.json" \
   --replica "lattice +0.05 mm=docs/notebook/paper_results/lattice_shift_0.05mm/results.json"
 echo "results in out/: <preset>.json (report), <preset>.stl, <preset>_half.glb, <preset>.png,"
 echo "  <preset>_half_t10.msh/.vtu + <preset>_mesh.json (T10 mesh and its report), tissue_particles.vtp/.json,"
 echo "  material_test.csv/.png/.json (the tissue card in uniaxial tension), stiffness_<preset>.json (tip compliance"
 echo "  and bending frequencies), sb_quick_run/ (a run folder: SB pushed through the cannula),"
-echo "  paper/ (report.md, results.json, plots and the four run folders: the paper reproduced), bench_*.txt"
+echo "  paper/ (report.md, results.json, plots and the four run folders: the paper reproduced), bench_*.txt,"
+echo "  bench_levels/ (speed_error.csv/.json/.png: the fast model level against the stored 10 mm reference)"

@@ -66,6 +66,14 @@ std::string describe_run_model(const json& scene, long particles) {
     if (skin_mm != default_contact.skin_mm || stiffness_factor != default_contact.stiffness_factor)
       d += fmt::format("; the contact's skin is {:g} mm and its stiffness factor {:g} (the defaults: {:g} and {:g})", skin_mm,
                        stiffness_factor, default_contact.skin_mm, default_contact.stiffness_factor);
+    // The full model level (the FE needle, the penalty contact) goes unnamed; another needle model or contact law is said.
+    const std::string law = contact.value("law", std::string("penalty"));
+    const std::string needle_model =
+        scene.contains("needle") && scene["needle"].is_object() ? scene["needle"].value("model", std::string("fe")) : std::string("fe");
+    if (law != "penalty" || (needle_model != "fe" && needle_model != "rigid"))
+      d += fmt::format("; the {} needle and the {} contact{}", needle_model == "implicit" ? "implicit linear" : needle_model,
+                       law == "projection" ? "kinematic (projection)" : law,
+                       needle_model == "implicit" && law == "projection" ? " (--model fast)" : "");
     // No cutting resistance is the default and goes unnamed; a resistance is said.
     const double cutting_MPa = contact.value("cutting_pressure_MPa", 0.0);
     if (cutting_MPa > 0)
