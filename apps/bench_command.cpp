@@ -1,5 +1,6 @@
 #include "apps/bench_command.h"
 
+#include <cmath>
 #include <filesystem>
 #include <fmt/format.h>
 #include <memory>
@@ -62,11 +63,7 @@ void bench_insertion(const BenchOptions& o) {
     for (const std::string& level : levels) {
       Scene scene = base;
       scene.tissue.enabled = true;
-      scene.needle.preset = needle;
-      scene.needle.d_a_mm = std::nan("");
-      scene.needle.recipe_file.clear();
-      scene.needle.mesh_file.clear();
-      scene.needle.plain_rod = false;
+      scene.needle.select_source(needle, std::nan(""), "");
       apply_model_level(scene, level, "--levels");
       cases.push_back({needle, level, (std::filesystem::path(o.out_dir) / fmt::format("{}_{}", needle, level)).string(), scene});
     }

@@ -32,14 +32,7 @@ void run(const RunCommandOptions& o) {
   NEEDLE_REQUIRE(sources == 1 || !o.scene_file.empty(), "give a needle (--preset, --d-a or --recipe) or a --scene");
   Scene scene = o.scene_file.empty() ? default_run_scene() : read_scene(o.scene_file);
   scene.tissue.enabled = true;
-  if (sources == 1) {
-    NeedleScene& n = scene.needle;
-    n.preset = o.preset;
-    n.d_a_mm = o.d_a_mm;
-    n.recipe_file = o.recipe;
-    n.mesh_file.clear();
-    n.plain_rod = false;
-  }
+  if (sources == 1) scene.needle.select_source(o.preset, o.d_a_mm, o.recipe);
   // The tissue's E: given, from a calibration, from the scene file, or (the run defaults) the SB calibration shipped
   // with the toolkit, so that the first run a user makes is the calibrated paper scene.
   NEEDLE_REQUIRE(std::isnan(o.tissue_E_MPa) || o.calibration_file.empty(), "give --tissue-E-MPa or --calibration, not both");

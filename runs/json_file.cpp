@@ -28,20 +28,12 @@ nlohmann::json parse_json_refusing_duplicates(std::istream& in, const std::strin
   const json::parser_callback_t check = [&](int, json::parse_event_t event, json& parsed) {
     switch (event) {
       case json::parse_event_t::object_start:
+      case json::parse_event_t::array_start:  // an array has no keys; its objects open their own sets
         keys.emplace_back();
         names.push_back(last_key);
         last_key.clear();
         break;
       case json::parse_event_t::object_end:
-        keys.pop_back();
-        names.pop_back();
-        last_key.clear();
-        break;
-      case json::parse_event_t::array_start:
-        keys.emplace_back();  // an array has no keys; its objects open their own sets
-        names.push_back(last_key);
-        last_key.clear();
-        break;
       case json::parse_event_t::array_end:
         keys.pop_back();
         names.pop_back();

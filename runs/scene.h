@@ -31,7 +31,16 @@ struct NeedleScene {
   bool half_model = true;   // z >= 0 half with a symmetry plane (paper)
   NeedleMeshOptions mesh;   // T10, 0.2 mm (paper)
   NeedleMaterial material;  // AISI 304
-  std::string model = "fe";  // the needle model (solver/needle/needle_models.h): "fe", or "rigid" (no deflection; tissue studies)
+  std::string model = "fe";  // the needle model (solver/needle/needle_models.h): "fe", "implicit", or "rigid" (no deflection; tissue studies)
+
+  // Makes exactly one of these the needle's source (the others, a mesh file and a plain rod cleared).
+  void select_source(const std::string& preset_name, double d_a, const std::string& recipe) {
+    preset = preset_name;
+    d_a_mm = d_a;
+    recipe_file = recipe;
+    mesh_file.clear();
+    plain_rod = false;
+  }
 };
 
 struct TissueScene {

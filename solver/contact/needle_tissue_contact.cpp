@@ -77,8 +77,9 @@ int NeedleTissueContact::nearest_surface_node(const Eigen::Vector3d& p, const Ei
   return best;
 }
 
-void NeedleTissueContact::probe(const std::vector<Vec3d>& x, const Eigen::MatrixX3d& needle_x, const std::vector<double>& reach) {
-  build_node_grid(needle_x);
+void NeedleTissueContact::probe(const std::vector<Vec3d>& x, const Eigen::MatrixX3d& needle_x, const std::vector<double>& reach,
+                                bool same_needle) {
+  if (!same_needle) build_node_grid(needle_x);
   double max_reach = 0;
   for (double r : reach) max_reach = std::max(max_reach, r);
   const double margin = node_cell_mm_ + options_.skin_mm + max_reach;

@@ -124,7 +124,8 @@ class NeedleTissueContact : public NeedleLoads {
     Pair pair;
   };
   // Level-set query of every particle at positions x (reach: how far outside the skin still counts as near).
-  void probe(const std::vector<Vec3d>& x, const Eigen::MatrixX3d& needle_x, const std::vector<double>& reach);
+  // same_needle: the needle has not moved since the last probe, whose grid of surface nodes serves again.
+  void probe(const std::vector<Vec3d>& x, const Eigen::MatrixX3d& needle_x, const std::vector<double>& reach, bool same_needle = false);
   Eigen::Vector3d surface_point(const Pair& pair, const Eigen::MatrixX3d& needle) const;
   // The needle's mass at a pair's contact point, by the force's weights (infinity without masses).
   double needle_mass_at(const Pair& pair) const;

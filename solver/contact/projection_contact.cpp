@@ -93,7 +93,7 @@ void ProjectionContact::end_step(TissueDynamics& tissue, const Eigen::MatrixX3d&
   // The check: the moved particles against the needle where it is.
   std::vector<Vec3d> moved(impulses.size());
   for (size_t k = 0; k < impulses.size(); ++k) moved[k] = particles.position_mm[static_cast<size_t>(impulses[k].first)];
-  probe(moved, needle_x, std::vector<double>(moved.size(), 0.0));
+  probe(moved, needle_x, std::vector<double>(moved.size(), 0.0), /*same_needle=*/true);
   report_.particles_inside = 0;
   report_.max_depth_mm = 0;
   for (const Probe& p : probes_)

@@ -60,7 +60,6 @@ class ImplicitNeedle : public NeedleModel {
   const Eigen::MatrixX3d& positions_mm() const override { return x_; }
   const Eigen::MatrixX3d& velocities_mm_per_ms() const override { return v_; }
   const NeedleEnergy& energy() const override { return energy_; }
-  Eigen::Vector3d momentum() const override { return (v_.array().colwise() * mass_.array()).colwise().sum().transpose(); }
   Eigen::Vector3d drive_displacement_mm() const override { return supports_.profile.displacement_mm(time_ms_) * supports_.direction; }
   Eigen::Vector3d drive_reaction_N() const override { return drive_reaction_; }
   Eigen::Vector3d drive_impulse_N_ms() const override { return drive_impulse_; }

@@ -70,8 +70,6 @@ class NeedleDynamics : public NeedleModel {
   Eigen::Vector3d drive_reaction_N() const override { return drive_reaction_; }
   // Its time integral since the start (N ms = g mm/ms): the momentum the drive has put in.
   Eigen::Vector3d drive_impulse_N_ms() const override { return drive_impulse_; }
-  // Total momentum of the needle (g mm/ms).
-  Eigen::Vector3d momentum() const override { return (v_.array().colwise() * mass_.array()).colwise().sum().transpose(); }
   // Where the driven base has moved the needle rigidly: d(t) direction.
   Eigen::Vector3d drive_displacement_mm() const override { return supports_.profile.displacement_mm(time_ms_) * supports_.direction; }
   ElementStresses element_stresses() const override { return needle_.element_stresses(x_); }

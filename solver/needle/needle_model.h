@@ -60,8 +60,10 @@ class NeedleModel {
   virtual const Eigen::MatrixX3d& positions_mm() const = 0;
   virtual const Eigen::MatrixX3d& velocities_mm_per_ms() const = 0;
   virtual const NeedleEnergy& energy() const = 0;
-  // Total momentum (g mm/ms).
-  virtual Eigen::Vector3d momentum() const = 0;
+  // Total momentum (g mm/ms), from the nodal masses and velocities.
+  Eigen::Vector3d momentum() const {
+    return (velocities_mm_per_ms().array().colwise() * nodal_mass_g().array()).colwise().sum().transpose();
+  }
   // Where the driven base has moved the needle rigidly, and the force the drive applies (N).
   virtual Eigen::Vector3d drive_displacement_mm() const = 0;
   virtual Eigen::Vector3d drive_reaction_N() const = 0;
