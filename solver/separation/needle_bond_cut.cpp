@@ -11,7 +11,13 @@ namespace needle {
 // The needle's current triangles (for a half model with the mirror images of those that touch the
 // symmetry plane) binned in a uniform grid over their bounding box: CSR over cells.
 struct NeedleBondCut::Grid {
-  std::vector<std::array<Eigen::Vector3d, 3>> triangles;
+  // A triangle as the segment test reads it: a corner, its two edges from there, the product of their lengths
+  // (the scale of the test for parallel segments) and its bounding box, widened by the test's tolerance.
+  struct Triangle {
+    Eigen::Vector3d v0, e1, e2, lo, hi;
+    double edge_lengths = 0;
+  };
+  std::vector<Triangle> triangles;
   Eigen::Vector3d lo = Eigen::Vector3d::Zero(), hi = Eigen::Vector3d::Zero();
   Eigen::Vector3i cells = Eigen::Vector3i::Zero();
   double cell_mm = 1;
@@ -29,15 +35,19 @@ namespace {
 constexpr double kBarycentricTolerance = 1e-9;  // a segment through a shared edge or the seam still hits
 constexpr double kDistinctCrossing = 1e-7;      // crossings closer than this (in s) are the same point
 
-// Parameter s in [0, 1] where a + s (b - a) meets triangle t (Moeller-Trumbore), or NaN.
-double segment_triangle(const Eigen::Vector3d& a, const Eigen::Vector3d& d, const std::array<Eigen::Vector3d, 3>& t) {
-  const Eigen::Vector3d e1 = t[1] - t[0], e2 = t[2] - t[0];
+constexpr double kBoxSlackMm = 1e-6;            // a triangle's box is widened by this before the exact test
+
+// Parameter s in [0, 1] where a + s (b - a) meets triangle t (Moeller-Trumbore), or NaN; length = |b - a|.
+template <class Triangle>
+double segment_triangle(const Eigen::Vector3d& a, const Eigen::Vector3d& d, double length, const Triangle& t) {
+  const Eigen::Vector3d& e1 = t.e1;
+  const Eigen::Vector3d& e2 = t.e2;
   const Eigen::Vector3d q = d.cross(e2);
   const double det = e1.dot(q);
-  const double scale = e1.norm() * e2.norm() * d.norm();
+  const double scale = t.edge_lengths * length;
   if (!(std::abs(det) > 1e-12 * scale)) return std::nan("");  // parallel to the triangle's plane
   const double inv = 1.0 / det;
-  const Eigen::Vector3d w = a - t[0];
+  const Eigen::Vector3d w = a - t.v0;
   const double u = w.dot(q) * inv;
   if (u < -kBarycentricTolerance || u > 1 + kBarycentricTolerance) return std::nan("");
   const Eigen::Vector3d r = w.cross(e1);
@@ -59,10 +69,20 @@ NeedleBondCut::Grid NeedleBondCut::build_grid(const Eigen::MatrixX3d& needle_x) 
   const Eigen::Vector3d lo = needle_x.colwise().minCoeff(), hi = needle_x.colwise().maxCoeff();
   const double plane_tol = 1e-9 * std::max(1.0, (hi - lo).norm());
   double extent_sum = 0;
+  const auto add = [&grid](const std::array<Eigen::Vector3d, 3>& v) {
+    Grid::Triangle t;
+    t.v0 = v[0];
+    t.e1 = v[1] - v[0];
+    t.e2 = v[2] - v[0];
+    t.edge_lengths = t.e1.norm() * t.e2.norm();
+    t.lo = v[0].cwiseMin(v[1]).cwiseMin(v[2]).array() - kBoxSlackMm;
+    t.hi = v[0].cwiseMax(v[1]).cwiseMax(v[2]).array() + kBoxSlackMm;
+    grid.triangles.push_back(t);
+  };
   for (Eigen::Index t = 0; t < tris.rows(); ++t) {
     std::array<Eigen::Vector3d, 3> v;
     for (int k = 0; k < 3; ++k) v[static_cast<size_t>(k)] = needle_x.row(tris(t, k)).transpose();
-    grid.triangles.push_back(v);
+    add(v);
     const Eigen::Vector3d tlo = v[0].cwiseMin(v[1]).cwiseMin(v[2]), thi = v[0].cwiseMax(v[1]).cwiseMax(v[2]);
     extent_sum += (thi - tlo).maxCoeff();
     // The mirror image closes a half model's surface; only triangles on the plane can meet a segment
@@ -70,7 +90,7 @@ NeedleBondCut::Grid NeedleBondCut::build_grid(const Eigen::MatrixX3d& needle_x) 
     if (surface_.half_model() && tlo.z() <= plane_tol) {
       std::array<Eigen::Vector3d, 3> m = v;
       for (auto& p : m) p.z() = -p.z();
-      grid.triangles.push_back(m);
+      add(m);
     }
   }
   grid.cell_mm = std::max(1.5 * extent_sum / static_cast<double>(tris.rows()), 1e-3);
@@ -83,9 +103,9 @@ NeedleBondCut::Grid NeedleBondCut::build_grid(const Eigen::MatrixX3d& needle_x) 
   const int count = grid.cells.prod();
   std::vector<std::pair<int, int>> cell_triangle;
   for (size_t t = 0; t < grid.triangles.size(); ++t) {
-    const auto& v = grid.triangles[t];
-    const Eigen::Vector3i c0 = grid.cell_of(v[0].cwiseMin(v[1]).cwiseMin(v[2]));
-    const Eigen::Vector3i c1 = grid.cell_of(v[0].cwiseMax(v[1]).cwiseMax(v[2]));
+    const Grid::Triangle& tri = grid.triangles[t];
+    const Eigen::Vector3i c0 = grid.cell_of(tri.lo);
+    const Eigen::Vector3i c1 = grid.cell_of(tri.hi);
     for (int i = c0.x(); i <= c1.x(); ++i)
       for (int j = c0.y(); j <= c1.y(); ++j)
         for (int k = c0.z(); k <= c1.z(); ++k) cell_triangle.emplace_back(grid.index(i, j, k), static_cast<int>(t));
@@ -107,12 +127,15 @@ std::vector<double> NeedleBondCut::crossings(const Grid& grid, const Eigen::Vect
   if ((hi.array() < grid.lo.array()).any() || (lo.array() > grid.hi.array()).any()) return s;
   const Eigen::Vector3i c0 = grid.cell_of(lo), c1 = grid.cell_of(hi);
   const Eigen::Vector3d d = b - a;
+  const double length = d.norm();
   for (int i = c0.x(); i <= c1.x(); ++i)
     for (int j = c0.y(); j <= c1.y(); ++j)
       for (int k = c0.z(); k <= c1.z(); ++k) {
         const int cell = grid.index(i, j, k);
         for (int e = grid.start[static_cast<size_t>(cell)]; e < grid.start[static_cast<size_t>(cell + 1)]; ++e) {
-          const double hit = segment_triangle(a, d, grid.triangles[static_cast<size_t>(grid.entries[static_cast<size_t>(e)])]);
+          const Grid::Triangle& t = grid.triangles[static_cast<size_t>(grid.entries[static_cast<size_t>(e)])];
+          if ((hi.array() < t.lo.array()).any() || (lo.array() > t.hi.array()).any()) continue;  // boxes apart: no hit
+          const double hit = segment_triangle(a, d, length, t);
           if (!std::isnan(hit)) s.push_back(hit);
         }
       }
