@@ -230,8 +230,15 @@ class InsertionRunModel : public RunModel {
     needle_model_ = make_needle_model(scene.needle.model, {*needle_, driven_base_supports(needle_->mesh(), scene.motion, scene.direction),
                                                            scene.cannula.enabled ? std::optional<CannulaOptions>(scene.cannula) : std::nullopt,
                                                            dynamics});
-    run_ = std::make_unique<CoupledInsertion>(*needle_model_, *tissue_, *surface_, scene.tissue.contact, std::move(separations),
-                                              scene.solver.coupling, cutting);
+    // The tissue's mass scaling to the coupling's own step unless a step is given: the implicit needle's (the
+    // coupling steps are whole multiples of it or fractions), for an explicit needle half the tissue's first.
+    CouplingOptions coupling = scene.solver.coupling;
+    if (scene.solver.tissue_mass_scaling || scene.solver.tissue_mass_scaling_dt_ms > 0)
+      coupling.tissue_mass_scaling_dt_ms = scene.solver.tissue_mass_scaling_dt_ms > 0 ? scene.solver.tissue_mass_scaling_dt_ms
+                                           : scene.needle.model == "implicit"         ? dynamics.implicit_step_ms
+                                                                                      : 0.5 * tissue_->stable_time_step_ms();
+    run_ = std::make_unique<CoupledInsertion>(*needle_model_, *tissue_, *surface_, scene.tissue.contact, std::move(separations), coupling,
+                                              cutting);
     tip_ = nearest_node(needle_->mesh(), built_.tip_point);
   }
 
@@ -250,9 +257,13 @@ class InsertionRunModel : public RunModel {
                         surface.level_set().build_seconds()),
             fmt::format("tissue: {} particles at {:.3g} mm ({:.3g} mm near the path), {} bonds; set-up {:.2f} s", particles_.num_particles(),
                         scene_.tissue.spacing_mm, particles_.spacing_mm.minCoeff(), tissue_->bonds().bonds.size(), setup_s_),
-            fmt::format("run to {:.6g} ms: needle step {:.4g} ms, first coupling step {:.4g} ms (tissue {:.4g}, contact {:.4g})", end_time_ms(),
+            fmt::format("run to {:.6g} ms: needle step {:.4g} ms, first coupling step {:.4g} ms (tissue {:.4g}, contact {:.4g}){}", end_time_ms(),
                         needle_model_->time_step_ms(), run_->tissue_dynamics().time_step_ms(), tissue_->stable_time_step_ms(),
-                        run_->contact_model().max_time_step_ms(scene_.solver.coupling.contact_courant))};
+                        run_->contact_model().max_time_step_ms(scene_.solver.coupling.contact_courant),
+                        run_->tissue_dynamics().mass_scaling()
+                            ? fmt::format("; particles whose own step falls below {:.4g} ms get mass (tissue mass scaling)",
+                                          run_->tissue_dynamics().mass_scaling()->target_dt_ms())
+                            : std::string())};
   }
   double end_time_ms() const override { return scene_.motion.end_time_ms(); }
   double time_ms() const override { return run_->time_ms(); }
@@ -294,6 +305,15 @@ class InsertionRunModel : public RunModel {
                                         "(tissue's lowest edge to the rod's top over floor to top), in the needle's own frame"}};
     summary["mesh"] = {{"order", needle_->mesh().order}, {"elements", needle_->num_elements()}, {"nodes", needle_->num_nodes()}};
     needle_model_->add_summary(summary);
+    if (const TissueMassScaling* scaling = run_->tissue_dynamics().mass_scaling()) {
+      const MassScalingReport& r = scaling->report();
+      summary["tissue_mass_scaling"] = {{"target_dt_ms", scaling->target_dt_ms()},
+                                        {"max_added_mass_percent", 100 * r.max_added_mass_g / scaling->physical_mass_g()},
+                                        {"added_mass_percent_at_end", 100 * r.added_mass_g / scaling->physical_mass_g()},
+                                        {"max_mass_ratio", r.max_ratio},
+                                        {"scaled_particles_at_end", r.scaled_particles},
+                                        {"kinetic_energy_added_mJ", r.energy_mJ}};
+    }
     if (run_->cutting()) run_->cutting()->add_summary(summary);
     for (const auto& separation : run_->separations()) separation->add_summary(summary, run_->tissue());
   }

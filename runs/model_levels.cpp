@@ -8,9 +8,10 @@ namespace needle {
 
 const std::vector<ModelLevel>& model_levels() {
   static const std::vector<ModelLevel> levels = {
-      {"full", "fe", "penalty", "explicit FE needle subcycled in the tissue's step, frictional penalty contact (the reference)"},
-      {"projection", "fe", "projection", "explicit FE needle, kinematic contact: the tissue's own step"},
-      {"fast", "implicit", "projection", "implicit linear needle at the coupling step, kinematic contact: no subcycling"},
+      {"full", "fe", "penalty", false, "explicit FE needle subcycled in the tissue's step, frictional penalty contact (the reference)"},
+      {"projection", "fe", "projection", false, "explicit FE needle, kinematic contact: the tissue's own step"},
+      {"fast", "implicit", "projection", true,
+       "implicit linear needle at the coupling step, kinematic contact, tissue mass-scaled to the needle's step: no subcycling"},
   };
   return levels;
 }
@@ -21,6 +22,8 @@ void apply_model_level(Scene& scene, const std::string& name, const std::string&
     if (level.name == name) {
       scene.needle.model = level.needle_model;
       scene.tissue.contact.law = level.contact_law;
+      scene.solver.tissue_mass_scaling = level.tissue_mass_scaling;
+      if (!level.tissue_mass_scaling) scene.solver.tissue_mass_scaling_dt_ms = 0;
       return;
     }
     known += (known.empty() ? "" : ", ") + level.name;
@@ -30,7 +33,9 @@ void apply_model_level(Scene& scene, const std::string& name, const std::string&
 
 std::string model_level_of(const Scene& scene) {
   for (const ModelLevel& level : model_levels())
-    if (scene.needle.model == level.needle_model && scene.tissue.contact.law == level.contact_law) return level.name;
+    if (scene.needle.model == level.needle_model && scene.tissue.contact.law == level.contact_law &&
+        (scene.solver.tissue_mass_scaling || scene.solver.tissue_mass_scaling_dt_ms > 0) == level.tissue_mass_scaling)
+      return level.name;
   return "custom";
 }
 

@@ -3,9 +3,10 @@
 // `needle bench`) can ask for "the fast model" or "the full model" without knowing the scene keys:
 //   full        the FE needle (explicit, subcycled) and the penalty contact: the reference, the paper's kind of model;
 //   projection  the FE needle and the kinematic contact: the contact no longer sets the step (one lever);
-//   fast        the implicit needle and the kinematic contact: no subcycling either (both levers).
-// Each level sets needle.model and tissue.contact.law; every other key stays the scene's. (The implicit needle
-// needs the kinematic contact: a penalty's force changes within a needle step.)
+//   fast        the implicit needle, the kinematic contact and the tissue mass-scaled to the needle's step: no
+//               subcycling, and the few particles squeezed under the tip no longer set everybody's step.
+// Each level sets needle.model, tissue.contact.law and solver.tissue_mass_scaling; every other key stays the
+// scene's. (The implicit needle needs the kinematic contact: a penalty's force changes within a needle step.)
 #include <string>
 #include <vector>
 
@@ -14,7 +15,9 @@
 namespace needle {
 
 struct ModelLevel {
-  std::string name, needle_model, contact_law, description;
+  std::string name, needle_model, contact_law;
+  bool tissue_mass_scaling = false;
+  std::string description;
 };
 
 const std::vector<ModelLevel>& model_levels();

@@ -166,6 +166,8 @@ void read_solver(SceneObject o, SolverScene& s) {
   s.max_penetration_mm = o.quantity("max_penetration", Dimension::length, s.max_penetration_mm, positive());
   s.implicit_needle_step_ms = o.quantity("implicit_needle_step", Dimension::time, s.implicit_needle_step_ms, within(0.0, 0.1));
   s.threads = o.integer("threads", s.threads, 0, 1024);
+  s.tissue_mass_scaling = o.boolean("tissue_mass_scaling", s.tissue_mass_scaling);
+  s.tissue_mass_scaling_dt_ms = o.quantity("tissue_mass_scaling_dt", Dimension::time, s.tissue_mass_scaling_dt_ms, within(0.0, 0.1));
   CouplingOptions& c = s.coupling;
   c.subcycling = o.boolean("subcycling", c.subcycling);
   c.max_step_ms = o.quantity("max_coupling_step", Dimension::time, c.max_step_ms, non_negative());
@@ -266,6 +268,8 @@ json scene_to_json(const Scene& s) {
                  {"max_coupling_step_ms", s.solver.coupling.max_step_ms}, {"contact_courant", s.solver.coupling.contact_courant},
                  {"max_contact_depth_mm", s.solver.coupling.max_depth_mm}};
   if (s.needle.model == "implicit") solver["implicit_needle_step_ms"] = s.solver.implicit_needle_step_ms;
+  if (s.solver.tissue_mass_scaling) solver["tissue_mass_scaling"] = true;
+  if (s.solver.tissue_mass_scaling_dt_ms > 0) solver["tissue_mass_scaling_dt_ms"] = s.solver.tissue_mass_scaling_dt_ms;
   return {
       {"needle", needle},
       {"motion", motion},

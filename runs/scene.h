@@ -67,6 +67,11 @@ struct SolverScene {
   double max_energy_error = 0.05;
   double max_penetration_mm = 0.05;
   double implicit_needle_step_ms = 0.0;  // the implicit needle's step (needle.model implicit); 0: about half the tissue's first stable step
+  // The tissue's selective mass scaling (solver/tissue/tissue_mass_scaling.h): on when the flag is set or a step
+  // is given; the step 0 means the coupling's own: the implicit needle's step (an explicit needle: half the
+  // tissue's first stable step).
+  bool tissue_mass_scaling = false;
+  double tissue_mass_scaling_dt_ms = 0.0;
   int threads = 0;
   CouplingOptions coupling;  // subcycling, step caps, the insertion's stop criteria
 };

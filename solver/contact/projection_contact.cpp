@@ -57,7 +57,7 @@ void ProjectionContact::end_step(TissueDynamics& tissue, const Eigen::MatrixX3d&
     const Probe& p = probes_[i];
     if (!p.near || !(p.pair.gap_start > 0) || (particles.flags[i] & kParticleFixed)) continue;
     const Pair& pair = p.pair;
-    const double m = mass_[i];
+    const double m = particles.mass_g[i];  // with the tissue's mass scaling, the scaled mass
     const Eigen::Vector3d jn = (m * pair.gap_start / dt) * pair.normal;
     const Eigen::Vector3d v_rel = particles.velocity_mm_per_ms[i] + jn / m - surface_point(pair, needle_v);
     const Eigen::Vector3d v_t = v_rel - v_rel.dot(pair.normal) * pair.normal;

@@ -16,6 +16,8 @@ void CouplingOptions::validate(const std::string& where) const {
                  fmt::format("{}: contact_courant must lie in (0, 1]", where));
   NEEDLE_REQUIRE(std::isfinite(max_energy_error) && max_energy_error > 0, fmt::format("{}: max_energy_error must be positive", where));
   NEEDLE_REQUIRE(std::isfinite(max_depth_mm) && max_depth_mm > 0, fmt::format("{}: max_depth_mm must be positive", where));
+  NEEDLE_REQUIRE(std::isfinite(tissue_mass_scaling_dt_ms) && tissue_mass_scaling_dt_ms >= 0,
+                 fmt::format("{}: tissue_mass_scaling_dt_ms must be zero or positive", where));
 }
 
 CoupledInsertion::CoupledInsertion(NeedleModel& needle, SpgTissue& tissue, const ContactSurface& surface, const ContactOptions& contact,
@@ -34,6 +36,7 @@ CoupledInsertion::CoupledInsertion(NeedleModel& needle, SpgTissue& tissue, const
   NEEDLE_REQUIRE(needle.steps() == 0 && needle.time_ms() == 0, "the coupled run must start with a needle at t = 0");
   NEEDLE_REQUIRE(surface.reference_positions().rows() == needle.positions_mm().rows(), "the contact surface belongs to another needle mesh");
   contact_->set_needle(needle.nodal_mass_g(), needle.time_step_ms());
+  tissue_dynamics_.set_mass_scaling(options_.tissue_mass_scaling_dt_ms);
   // The contact at t = 0 (particles placed within a penalty's skin already push), on both bodies.
   contact_->begin_step(tissue.particles(), needle.positions_mm(), needle.velocities_mm_per_ms(), 0.0,
                        tissue_dynamics_.time_step_ms(contact_->max_time_step_ms(options_.contact_courant)));

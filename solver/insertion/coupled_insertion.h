@@ -41,6 +41,7 @@ struct CouplingOptions {
                                 // take: the accuracy knob of the subcycling (its error is first order in it)
   double max_energy_error = 0.05;    // stop when the physical balance drifts beyond this (once the work from outside exceeds the energy at t = 0)
   double max_depth_mm = 0.3;         // stop when a particle gets this deep inside the needle
+  double tissue_mass_scaling_dt_ms = 0.0;  // the tissue's selective mass scaling to this step (0: none; tissue_mass_scaling.h)
   Eigen::Vector3d tissue_body_acceleration_mm_per_ms2 = Eigen::Vector3d::Zero();  // e.g. to press a block on
   void validate(const std::string& where = "coupling") const;
 };

@@ -14,6 +14,7 @@ struct InsertionEnergy {
   double tissue_kinetic_mJ = 0, tissue_internal_mJ = 0;  // internal: stored + plastically dissipated (-W_model)
   double needle_kinetic_mJ = 0, needle_strain_mJ = 0, needle_initial_mJ = 0, tissue_initial_kinetic_mJ = 0;
   double drive_work_mJ = 0, cannula_work_mJ = 0, tissue_reaction_work_mJ = 0, body_work_mJ = 0;
+  double mass_scaling_mJ = 0;  // kinetic energy the tissue's mass scaling added to the particles (an input, tissue_mass_scaling.h)
   double contact_work_mJ = 0;  // work of the contact forces on both bodies (should equal -(E_penalty + D_friction))
   double relinearisation_energy_mJ = 0;  // the contact's penalty jumps at geometry updates (diagnostic, not in the balance)
   double penalty_energy_mJ = 0, initial_penalty_energy_mJ = 0, friction_dissipation_mJ = 0;  // initial: overlaps at t = 0; friction: with cutting

@@ -354,6 +354,24 @@ double SpgTissue::stable_time_step_ms() const {
   return options_.cfl * shortest / wave_speed;
 }
 
+void SpgTissue::particle_time_steps_ms(std::vector<double>& dt_ms) const {
+  const double factor = options_.stabilization == Stabilization::penalty ? 1.0 + 4.0 * options_.stabilization_coefficient : 1.0;
+  const double rho = material_.density_g_per_mm3();
+  dt_ms.resize(static_cast<size_t>(p_.size()));
+  parallel_for(p_.size(), [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t i = begin; i < end; ++i) {
+      const size_t s = static_cast<size_t>(i);
+      if (!rk_.valid[s]) {
+        dt_ms[s] = std::numeric_limits<double>::infinity();
+        continue;
+      }
+      const double strain = p_.effective_strain[s] - p_.plastic_strain[s];
+      const double wave_speed = std::sqrt(material_.tangent_p_wave_modulus_MPa(std::max(strain, 0.0)) * factor / rho);
+      dt_ms[s] = options_.cfl * stable_length_mm_[s] * min_stretch_[s] / wave_speed;
+    }
+  });
+}
+
 void SpgTissue::end_of_step() {
   ++steps_;
   if (options_.stabilization == Stabilization::filter && steps_ % options_.smoothing_interval_steps == 0) apply_filter();

@@ -68,6 +68,9 @@ class SpgTissue {
 
   // The smallest current spacing over the dilatational wave speed (with stabilization stiffness), x cfl.
   double stable_time_step_ms() const;
+  // Each particle's own stable step, the same estimate with its own current support length and its own
+  // strain (infinite for a detached particle, which no force holds); their minimum is at least the above.
+  void particle_time_steps_ms(std::vector<double>& dt_ms) const;
 
   // Called by the integrator once per step (counts steps for the filter and the kernel update).
   void end_of_step();

@@ -12,10 +12,12 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <utility>
 #include <vector>
 
 #include "solver/tissue/spg_tissue.h"
+#include "solver/tissue/tissue_mass_scaling.h"
 
 namespace needle {
 
@@ -33,7 +35,8 @@ struct EnergyBalance {
   double external_work_mJ = 0;     // work of external forces (contact with the needle)
   double constraint_work_mJ = 0;
   double initial_kinetic_mJ = 0;
-  // |KE - KE0 - W_model - W_body - W_external - W_constraint| / max(|terms|): the integrator's drift
+  double mass_scaling_mJ = 0;      // kinetic energy the mass scaling's mass changes added (tissue_mass_scaling.h)
+  // |KE - KE0 - W_model - W_body - W_external - W_constraint - E_mass_scaling| / max(|terms|): the integrator's drift
   double relative_error() const;
 };
 
@@ -54,12 +57,18 @@ class TissueDynamics {
   // act like internal forces in the step, and their work is booked apart.
   void set_external_forces(const std::vector<Vec3d>& force_N);
 
-  // The step the next step will take: the tissue's stable step capped at max_dt_ms.
+  // Selective mass scaling to this step (tissue_mass_scaling.h), before the first step; 0: none.
+  void set_mass_scaling(double target_dt_ms);
+  const TissueMassScaling* mass_scaling() const { return mass_scaling_.get(); }
+
+  // The step the next step will take: the tissue's stable step (with mass scaling at least its target)
+  // capped at max_dt_ms.
   double time_step_ms(double max_dt_ms = std::numeric_limits<double>::infinity()) const;
   // One step in two halves, so that another body can move between them (the coupled insertion):
   //   kick_and_drift: v(n+1/2) = v(n) + dt/2 a(n), constraints, x(n+1) = x(n) + dt v(n+1/2), t += dt;
-  //     dt is the tissue's stable step capped at max_dt_ms (> 0); returns it. SolverError on a collapsed
-  //     time step (below 1e-4 of the first).
+  //     dt is the tissue's stable step capped at max_dt_ms (> 0); returns it. With mass scaling the
+  //     masses are first set for dt (momentum kept). SolverError on a collapsed time step (below 1e-4 of
+  //     the first, unscaled).
   //   finish_step: forces at x(n+1) with the external forces given (nullptr: the last ones, unchanged),
   //     the work of each force, v(n+1) = v(n+1/2) + dt/2 a(n+1), constraints and their work. SolverError
   //     on non-finite forces or energy.
@@ -90,6 +99,7 @@ class TissueDynamics {
   void half_kick(std::vector<Vec3d>& v, double dt) const;  // v += dt/2 a, per particle (in parallel)
 
   SpgTissue& tissue_;
+  std::unique_ptr<TissueMassScaling> mass_scaling_;
   std::vector<VelocityConstraint> constraints_;
   Eigen::Vector3d body_acceleration_;
   double time_ms_ = 0, first_dt_ms_ = 0, step_dt_ms_ = 0;

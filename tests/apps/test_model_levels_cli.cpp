@@ -1,5 +1,5 @@
-// The model levels on the command line (runs/model_levels.h): --model sets the needle model and the contact law
-// together, a wrong name or combination is refused with nothing written; `needle bench insertion` runs each level
+// The model levels on the command line (runs/model_levels.h): --model sets the needle model, the contact law and
+// the tissue's mass scaling together, a wrong name or combination is refused with nothing written; `needle bench insertion` runs each level
 // on one scene and writes the speed-against-error table from the runs' own summaries.
 #include <catch2/catch.hpp>
 #include <filesystem>
@@ -23,6 +23,17 @@ TEST_CASE("needle run --model fast runs the implicit needle with the kinematic c
   CHECK(fast.summary["particles_inside"].get<int>() == 0);
   // One needle step or a few per coupling step, where the explicit needle takes hundreds.
   CHECK(fast.summary["needle_steps"].get<long>() < 4 * fast.summary["steps"].get<long>());
+  // The tissue mass-scaled to the needle's step: the scene says so, the summary gives the target and what was added.
+  CHECK(fast.scene["solver"]["tissue_mass_scaling"] == true);
+  REQUIRE(fast.summary.contains("tissue_mass_scaling"));
+  CHECK(fast.summary["tissue_mass_scaling"]["target_dt_ms"].get<double>() == Approx(fast.summary["needle_time_step_ms"].get<double>()));
+  CHECK(fast.summary["tissue_mass_scaling"]["max_mass_ratio"].get<double>() >= 1.0);
+  CHECK(fast.summary["tissue_mass_scaling"]["kinetic_energy_added_mJ"].get<double>() <= 0.0);
+  // Without it (a custom level) the run takes the tissue's own, smaller steps.
+  const RunFiles unscaled = run_sb_into_small_block("model_fast_unscaled", "--model fast --set solver.tissue_mass_scaling=false");
+  CHECK(unscaled.summary["model_level"] == "custom");
+  CHECK(!unscaled.summary.contains("tissue_mass_scaling"));
+  CHECK(unscaled.summary["steps"].get<long>() >= fast.summary["steps"].get<long>());
   const RunFiles full = run_sb_into_small_block("model_full", "--model full");
   CHECK(full.summary["model_level"] == "full");
   CHECK(full.summary["needle_steps"].get<long>() > 20 * full.summary["steps"].get<long>());
