@@ -70,10 +70,15 @@ std::string describe_run_model(const json& scene, long particles) {
     const std::string law = contact.value("law", std::string("penalty"));
     const std::string needle_model =
         scene.contains("needle") && scene["needle"].is_object() ? scene["needle"].value("model", std::string("fe")) : std::string("fe");
+    const json solver = scene.value("solver", json::object());
+    const bool mass_scaled = solver.value("tissue_mass_scaling", false) || solver.value("tissue_mass_scaling_dt_ms", 0.0) > 0;
     if (law != "penalty" || (needle_model != "fe" && needle_model != "rigid"))
-      d += fmt::format("; the {} needle and the {} contact{}", needle_model == "implicit" ? "implicit linear" : needle_model,
+      d += fmt::format("; the {} needle and the {} contact{}{}", needle_model == "implicit" ? "implicit linear" : needle_model,
                        law == "projection" ? "kinematic (projection)" : law,
-                       needle_model == "implicit" && law == "projection" ? " (--model fast)" : "");
+                       mass_scaled ? ", the tissue mass-scaled to the needle's step" : "",
+                       needle_model == "implicit" && law == "projection" && mass_scaled ? " (--model fast)" : "");
+    else if (mass_scaled)
+      d += "; the tissue mass-scaled to the needle's step";
     // No cutting resistance is the default and goes unnamed; a resistance is said.
     const double cutting_MPa = contact.value("cutting_pressure_MPa", 0.0);
     if (cutting_MPa > 0)

@@ -152,8 +152,8 @@ std::vector<double> NeedleBondCut::surface_crossings(const Eigen::Vector3d& a, c
 std::vector<std::int64_t> NeedleBondCut::bonds_through_needle(const BondNetwork& bonds, const std::vector<Vec3d>& x,
                                                               const Eigen::MatrixX3d& needle_x) const {
   const Grid grid = build_grid(needle_x);
-  return select_intact_bonds(bonds, [&](const Bond& bond) {
-    return crossings(grid, x[static_cast<size_t>(bond.i)], x[static_cast<size_t>(bond.j)]).size() >= 2;
+  return select_intact_bonds(bonds, [&](std::int32_t i, std::int32_t j) {
+    return crossings(grid, x[static_cast<size_t>(i)], x[static_cast<size_t>(j)]).size() >= 2;
   });
 }
 

@@ -39,9 +39,9 @@ std::vector<std::int64_t> TipCrack::bonds_across(const BondNetwork& bonds, const
     const Eigen::Vector3d u(0, std::sin(psi), std::cos(psi));
     fins.push_back({u, Eigen::Vector3d::UnitX().cross(u)});
   }
-  return select_intact_bonds(bonds, [&](const Bond& bond) {
-    const Vec3d& p = x[static_cast<size_t>(bond.i)];
-    const Vec3d& q = x[static_cast<size_t>(bond.j)];
+  return select_intact_bonds(bonds, [&](std::int32_t i, std::int32_t j) {
+    const Vec3d& p = x[static_cast<size_t>(i)];
+    const Vec3d& q = x[static_cast<size_t>(j)];
     if (std::max(p.x(), q.x()) < x_lo || std::min(p.x(), q.x()) > x_hi) return false;
     const Eigen::Vector3d a = p - tip, d = q - p;
     for (const Fin& fin : fins) {

@@ -2,7 +2,10 @@
 // Bonds: the particle pairs that interact, i.e. j in the support covering i or i in the support covering
 // j. A bond names its (up to two) shape-function entries; breaking it cuts both, so the pair leaves each
 // other's supports and the rows are rebuilt without it.
+#include <algorithm>
 #include <cstdint>
+#include <mutex>
+#include <utility>
 #include <vector>
 
 #include "core/parallel.h"
@@ -17,28 +20,75 @@ struct Bond {
   bool broken = false;
 };
 
+// An intact bond's two particles, compact, for the scans that test every intact bond each step.
+struct IntactPair {
+  std::int32_t i, j, bond;
+};
+
 struct BondNetwork {
   std::vector<Bond> bonds;
   std::int64_t broken_count = 0;  // all broken bonds: by the failure criterion, dead, or cut
   std::int64_t cut_count = 0;     // of those, the ones cut by a body through them (SpgTissue::cut_bonds)
+  // Each particle's bonds (CSR, increasing bond index): a bond is listed under both its particles.
+  std::vector<std::int64_t> particle_offset;
+  std::vector<std::int32_t> particle_bonds;
+  // The pairs of the intact bonds in increasing bond order, 12 bytes each where a Bond is 32: a bond broken
+  // since the last compaction is still listed (its Bond says broken); mark_broken compacts now and then.
+  std::vector<IntactPair> intact;
+  std::int64_t listed_broken = 0;
+
+  // Builds the particle lists and the pair list from `bonds` (build_bond_network does; a network made by hand
+  // calls it), for this many particles.
+  void index(std::int64_t particles);
+  // Marks bond b broken (it must be intact) and compacts the pair list once a fiftieth of it is broken.
+  void mark_broken(std::int64_t b);
 };
 
 BondNetwork build_bond_network(const RkShapeFunctions& rk);
 
-// The intact bonds for which selected(bond) holds, in increasing order; tested in parallel (selected must only read).
+// The intact bonds whose pair (i, j) satisfies selected(i, j), in increasing order: a parallel scan of the
+// compact pair list (selected must only read).
 template <class Selected>
 std::vector<std::int64_t> select_intact_bonds(const BondNetwork& bonds, const Selected& selected) {
-  const std::int64_t n = static_cast<std::int64_t>(bonds.bonds.size());
-  std::vector<std::uint8_t> chosen(static_cast<size_t>(n), 0);
-  parallel_for(n, [&](std::int64_t begin, std::int64_t end) {
-    for (std::int64_t b = begin; b < end; ++b) {
-      const Bond& bond = bonds.bonds[static_cast<size_t>(b)];
-      chosen[static_cast<size_t>(b)] = !bond.broken && selected(bond);
+  std::mutex merge;
+  std::vector<std::pair<std::int64_t, std::vector<std::int64_t>>> chunks;
+  parallel_for(static_cast<std::int64_t>(bonds.intact.size()), [&](std::int64_t begin, std::int64_t end) {
+    std::vector<std::int64_t> found;
+    for (std::int64_t k = begin; k < end; ++k) {
+      const IntactPair& pair = bonds.intact[static_cast<size_t>(k)];
+      if (selected(pair.i, pair.j) && !bonds.bonds[static_cast<size_t>(pair.bond)].broken) found.push_back(pair.bond);
     }
+    if (found.empty()) return;
+    const std::lock_guard<std::mutex> lock(merge);
+    chunks.emplace_back(begin, std::move(found));
   });
+  std::sort(chunks.begin(), chunks.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   std::vector<std::int64_t> out;
-  for (std::int64_t b = 0; b < n; ++b)
-    if (chosen[static_cast<size_t>(b)]) out.push_back(b);
+  for (auto& chunk : chunks) out.insert(out.end(), chunk.second.begin(), chunk.second.end());
+  return out;
+}
+
+// The bonds of a sorted list (intact ones) for which kind(bond) is not 0, with that kind, in the list's order;
+// tested in parallel (kind must only read).
+template <class Kind>
+std::vector<std::pair<std::int64_t, std::uint8_t>> classify_bonds(const BondNetwork& bonds, const std::vector<std::int32_t>& listed,
+                                                                  const Kind& kind) {
+  using Found = std::vector<std::pair<std::int64_t, std::uint8_t>>;
+  std::mutex merge;
+  std::vector<std::pair<std::int64_t, Found>> chunks;
+  parallel_for(static_cast<std::int64_t>(listed.size()), [&](std::int64_t begin, std::int64_t end) {
+    Found found;
+    for (std::int64_t k = begin; k < end; ++k) {
+      const std::int64_t b = listed[static_cast<size_t>(k)];
+      if (const std::uint8_t c = kind(bonds.bonds[static_cast<size_t>(b)])) found.emplace_back(b, c);
+    }
+    if (found.empty()) return;
+    const std::lock_guard<std::mutex> lock(merge);
+    chunks.emplace_back(begin, std::move(found));
+  });
+  std::sort(chunks.begin(), chunks.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  Found out;
+  for (auto& chunk : chunks) out.insert(out.end(), chunk.second.begin(), chunk.second.end());
   return out;
 }
 

@@ -90,12 +90,13 @@ class SpgTissue {
  private:
   void build_kernel();
   void update_stable_lengths();
+  void update_shortest_bonds();  // each particle's shortest bond in the reference configuration
   void apply_filter();
   void reinitialize_kernel();
   std::int64_t break_bonds();
-  // Marks the bonds flagged in breaking (1: cut, 2: dead, no live row changes) broken and rebuilds the rows
-  // of their particles; the count of those newly broken.
-  std::int64_t separate(const std::vector<std::uint8_t>& breaking);
+  // Marks the bonds listed in breaking, in increasing order with their kind (1: cut, 2: dead, no live row
+  // changes), broken and rebuilds the rows of their particles; the count of those newly broken.
+  std::int64_t separate(const std::vector<std::pair<std::int64_t, std::uint8_t>>& breaking);
   // Whether a crack-face particle's support still measures a volume (SpgOptions::crack_face_min_volume_ratio).
   bool crack_face_support_holds(const Mat3d& F, double J) const;
   // Particle s stops being an integration point: its row, smoothing defect and stress are cleared; it
@@ -119,6 +120,8 @@ class SpgTissue {
   std::vector<Vec3d> defect_;      // g_i
   std::vector<Mat3d> piola_volume_;  // V_i P_i
   std::int64_t steps_ = 0;
+  std::vector<double> shortest_bond_mm_;  // per particle (infinite without bonds)
+  std::vector<std::uint8_t> active_;      // break_bonds' scratch: particles whose bonds may break
   std::int64_t detached_on_rebuild_ = 0;  // crack-face particles separate() detached (counted into ForceReport)
 };
 

@@ -23,12 +23,14 @@ struct VerticalBonds {
           if (j > 0) bonds.bonds.push_back({static_cast<std::int32_t>(x.size() - 1), static_cast<std::int32_t>(x.size())});
           x.push_back(Vec3d(0.2 * i, -0.3 + 0.2 * j, 0.2 * k));
         }
+    bonds.index(static_cast<std::int64_t>(x.size()));
   }
   // Appends a bond between two new particles; returns its index.
   std::int64_t add(const Vec3d& a, const Vec3d& b) {
     x.push_back(a);
     x.push_back(b);
     bonds.bonds.push_back({static_cast<std::int32_t>(x.size() - 2), static_cast<std::int32_t>(x.size() - 1)});
+    bonds.index(static_cast<std::int64_t>(x.size()));
     return static_cast<std::int64_t>(bonds.bonds.size() - 1);
   }
 };

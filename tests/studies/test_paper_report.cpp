@@ -158,6 +158,7 @@ TEST_CASE("needle paper --report-only names the tissue law, the relaxation, the 
                                        {"stiffness_factor", 10.0}, {"law", "projection"}}},
                           {"material", {{"law", "stiffening_elastic"}, {"relaxing_shear_fraction", 0.5}, {"relaxation_time_ms", 0.2}}}}},
                         {"motion", {{"speed_m_per_s", 4.0}}},
+                        {"solver", {{"tissue_mass_scaling", true}}},
                         {"needle", {{"groove_start_mm", 5.0}, {"model", "implicit"}}}};
     std::ofstream(dir / "runs" / name / "scene.json") << scene.dump(2);
   }
@@ -171,7 +172,8 @@ TEST_CASE("needle paper --report-only names the tissue law, the relaxation, the 
                                           "the tip drives a crack past the rod: fins from the tip point at 0, -45 deg in the cross-section "
                                           "(0: horizontal), 1.2 mm long, running 0.5 mm ahead of the tip; "
                                           "the contact's skin is 0.04 mm and its stiffness factor 10 (the defaults: 0.02 and 30); "
-                                          "the implicit linear needle and the kinematic (projection) contact (--model fast); "
+                                          "the implicit linear needle and the kinematic (projection) contact, the tissue mass-scaled to the "
+                                          "needle's step (--model fast); "
                                           "cutting the tissue costs work: a pressure of 0.3 MPa on the tip facets that advance into it; "
                                           "the block's entry face is 0.1 mm ahead of the tip's start (the particle lattice shifted against the "
                                           "path; the tip ends that much less deep); the needle is driven at 4 m/s (the paper's model: 8); the groove starts 5 mm behind the tip point (the presets': 3)") !=
