@@ -9,6 +9,7 @@
 // gathered through the transposed shape functions, so results do not depend on the thread count.
 #include <Eigen/Dense>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "mesher/particle_lattice.h"
@@ -70,7 +71,8 @@ class SpgTissue {
   double stable_time_step_ms() const;
   // Each particle's own stable step, the same estimate with its own current support length and its own
   // strain (infinite for a detached particle, which no force holds); their minimum is at least the above.
-  void particle_time_steps_ms(std::vector<double>& dt_ms) const;
+  // Where a bound shows a particle's step is known_above_ms or more, that bound is given instead.
+  void particle_time_steps_ms(std::vector<double>& dt_ms, double known_above_ms = std::numeric_limits<double>::infinity()) const;
 
   // Called by the integrator once per step (counts steps for the filter and the kernel update).
   void end_of_step();
@@ -114,7 +116,12 @@ class SpgTissue {
   BondNetwork bonds_;
   std::vector<double> stiffness_;  // kappa_i of the penalty
   std::vector<double> stable_length_mm_;  // min(spacing, nearest neighbour distance) in the kernel reference
-  std::vector<double> min_stretch_;       // smallest principal stretch of F, kept by compute_forces
+  // The smallest principal stretch of F: bounds kept by compute_forces, the value itself (-1: not yet)
+  // computed by min_stretch(s) for the particles a time step needs.
+  void set_stretch_bounds(size_t s);
+  double min_stretch(size_t s) const;
+  mutable std::vector<double> min_stretch_;
+  std::vector<double> stretch_lower_, stretch_upper_;
   std::vector<std::uint8_t> point_status_;  // scratch flags of compute_forces
   Eigen::MatrixX3d reference_;            // #P by 3 copy of reference_mm for the shape-function builders
   std::vector<Vec3d> defect_;      // g_i

@@ -19,7 +19,7 @@ double TissueMassScaling::time_step_ms(double unscaled_stable_dt_ms) const { ret
 
 const std::vector<std::int32_t>& TissueMassScaling::apply(double dt_ms, const SpgTissue& tissue, TissueParticles& p,
                                                           const std::vector<std::uint8_t>& constrained_mask) {
-  tissue.particle_time_steps_ms(particle_dt_ms_);
+  tissue.particle_time_steps_ms(particle_dt_ms_, dt_ms);  // exact below dt_ms, where masses are set
   changed_.clear();
   // Particles that need mass now, and those that had it (they may get their physical mass back).
   std::vector<std::int32_t> scaled_now;
