@@ -78,7 +78,8 @@ int NeedleTissueContact::nearest_surface_node(const Eigen::Vector3d& p, const Ei
 }
 
 void NeedleTissueContact::probe(const std::vector<Vec3d>& x, const Eigen::MatrixX3d& needle_x, const std::vector<double>& reach,
-                                bool same_needle) {
+                                bool same_needle, std::vector<Probe>* out) {
+  std::vector<Probe>& probes = out ? *out : probes_;
   if (!same_needle) build_node_grid(needle_x);
   double max_reach = 0;
   for (double r : reach) max_reach = std::max(max_reach, r);
@@ -88,11 +89,11 @@ void NeedleTissueContact::probe(const std::vector<Vec3d>& x, const Eigen::Matrix
   const Eigen::MatrixX3i& tri = surface_.triangles();
   const Eigen::MatrixX3d& X0 = surface_.reference_positions();
   const double skin = options_.skin_mm;
-  probes_.resize(x.size());
+  probes.resize(x.size());
   parallel_for(static_cast<std::int64_t>(x.size()), [&](std::int64_t begin, std::int64_t end) {
     for (std::int64_t i = begin; i < end; ++i) {
       const size_t s = static_cast<size_t>(i);
-      Probe& probe = probes_[s];
+      Probe& probe = probes[s];
       probe = Probe{};
       const Eigen::Vector3d p = x[s];
       if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) continue;

@@ -125,7 +125,9 @@ class NeedleTissueContact : public NeedleLoads {
   };
   // Level-set query of every particle at positions x (reach: how far outside the skin still counts as near).
   // same_needle: the needle has not moved since the last probe, whose grid of surface nodes serves again.
-  void probe(const std::vector<Vec3d>& x, const Eigen::MatrixX3d& needle_x, const std::vector<double>& reach, bool same_needle = false);
+  // The probes go to `out` (default: probes_), one per position.
+  void probe(const std::vector<Vec3d>& x, const Eigen::MatrixX3d& needle_x, const std::vector<double>& reach, bool same_needle = false,
+             std::vector<Probe>* out = nullptr);
   Eigen::Vector3d surface_point(const Pair& pair, const Eigen::MatrixX3d& needle) const;
   // The needle's mass at a pair's contact point, by the force's weights (infinity without masses).
   double needle_mass_at(const Pair& pair) const;

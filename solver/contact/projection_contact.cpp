@@ -93,10 +93,10 @@ void ProjectionContact::end_step(TissueDynamics& tissue, const Eigen::MatrixX3d&
   // The check: the moved particles against the needle where it is.
   std::vector<Vec3d> moved(impulses.size());
   for (size_t k = 0; k < impulses.size(); ++k) moved[k] = particles.position_mm[static_cast<size_t>(impulses[k].first)];
-  probe(moved, needle_x, std::vector<double>(moved.size(), 0.0), /*same_needle=*/true);
+  probe(moved, needle_x, std::vector<double>(moved.size(), 0.0), /*same_needle=*/true, &check_probes_);
   report_.particles_inside = 0;
   report_.max_depth_mm = 0;
-  for (const Probe& p : probes_)
+  for (const Probe& p : check_probes_)
     if (p.inside) {
       ++report_.particles_inside;
       report_.max_depth_mm = std::max(report_.max_depth_mm, -p.phi);

@@ -61,6 +61,7 @@ class ProjectionContact : public NeedleTissueContact {
   };
   std::vector<Reaction> pending_;  // from the last step's end, acting over the current step
   NodalForces pending_force_;      // pending_ as nodal forces over the current step, one entry per node
+  std::vector<Probe> check_probes_;  // the moved particles' probes after the impulses (probes_ keeps all particles')
   double step_dt_ms_ = 0, particle_work_mJ_ = 0, needle_work_mJ_ = 0;
 };
 

@@ -101,23 +101,21 @@ NeedleBondCut::Grid NeedleBondCut::build_grid(const Eigen::MatrixX3d& needle_x) 
   grid.hi.array() += grid.cell_mm;
   grid.cells = ((grid.hi - grid.lo) / grid.cell_mm).array().ceil().cast<int>().cwiseMax(1);
   const int count = grid.cells.prod();
-  std::vector<std::pair<int, int>> cell_triangle;
-  for (size_t t = 0; t < grid.triangles.size(); ++t) {
-    const Grid::Triangle& tri = grid.triangles[t];
+  // Each cell's triangles in increasing order (a counting sort: two passes over the triangles' cells).
+  const auto for_each_cell = [&grid](const Grid::Triangle& tri, const auto& visit) {
     const Eigen::Vector3i c0 = grid.cell_of(tri.lo);
     const Eigen::Vector3i c1 = grid.cell_of(tri.hi);
     for (int i = c0.x(); i <= c1.x(); ++i)
       for (int j = c0.y(); j <= c1.y(); ++j)
-        for (int k = c0.z(); k <= c1.z(); ++k) cell_triangle.emplace_back(grid.index(i, j, k), static_cast<int>(t));
-  }
-  std::sort(cell_triangle.begin(), cell_triangle.end());
+        for (int k = c0.z(); k <= c1.z(); ++k) visit(grid.index(i, j, k));
+  };
   grid.start.assign(static_cast<size_t>(count + 1), 0);
-  grid.entries.reserve(cell_triangle.size());
-  for (const auto& [cell, t] : cell_triangle) {
-    ++grid.start[static_cast<size_t>(cell + 1)];
-    grid.entries.push_back(t);
-  }
+  for (const Grid::Triangle& tri : grid.triangles) for_each_cell(tri, [&](int cell) { ++grid.start[static_cast<size_t>(cell + 1)]; });
   for (size_t c = 1; c < grid.start.size(); ++c) grid.start[c] += grid.start[c - 1];
+  grid.entries.resize(static_cast<size_t>(grid.start.back()));
+  std::vector<int> next(grid.start.begin(), grid.start.end() - 1);
+  for (size_t t = 0; t < grid.triangles.size(); ++t)
+    for_each_cell(grid.triangles[t], [&](int cell) { grid.entries[static_cast<size_t>(next[static_cast<size_t>(cell)]++)] = static_cast<int>(t); });
   return grid;
 }
 
