@@ -22,6 +22,7 @@ struct NeedleBondCut::Grid {
   Eigen::Vector3i cells = Eigen::Vector3i::Zero();
   double cell_mm = 1;
   std::vector<int> start, entries;
+  std::vector<std::uint8_t> near;  // per cell: 1 when the cell or one of its 26 neighbours holds a triangle
 
   Eigen::Vector3i cell_of(const Eigen::Vector3d& p) const {
     Eigen::Vector3i c = ((p - lo) / cell_mm).array().floor().cast<int>();
@@ -116,6 +117,16 @@ NeedleBondCut::Grid NeedleBondCut::build_grid(const Eigen::MatrixX3d& needle_x) 
   std::vector<int> next(grid.start.begin(), grid.start.end() - 1);
   for (size_t t = 0; t < grid.triangles.size(); ++t)
     for_each_cell(grid.triangles[t], [&](int cell) { grid.entries[static_cast<size_t>(next[static_cast<size_t>(cell)]++)] = static_cast<int>(t); });
+  grid.near.assign(static_cast<size_t>(count), 0);
+  for (int i = 0; i < grid.cells.x(); ++i)
+    for (int j = 0; j < grid.cells.y(); ++j)
+      for (int k = 0; k < grid.cells.z(); ++k) {
+        const int cell = grid.index(i, j, k);
+        if (grid.start[static_cast<size_t>(cell)] == grid.start[static_cast<size_t>(cell + 1)]) continue;
+        for (int a = std::max(i - 1, 0); a <= std::min(i + 1, grid.cells.x() - 1); ++a)
+          for (int b = std::max(j - 1, 0); b <= std::min(j + 1, grid.cells.y() - 1); ++b)
+            for (int c = std::max(k - 1, 0); c <= std::min(k + 1, grid.cells.z() - 1); ++c) grid.near[static_cast<size_t>(grid.index(a, b, c))] = 1;
+      }
   return grid;
 }
 
@@ -151,7 +162,14 @@ std::vector<std::int64_t> NeedleBondCut::bonds_through_needle(const BondNetwork&
                                                               const Eigen::MatrixX3d& needle_x) const {
   const Grid grid = build_grid(needle_x);
   return select_intact_bonds(bonds, [&](std::int32_t i, std::int32_t j) {
-    return crossings(grid, x[static_cast<size_t>(i)], x[static_cast<size_t>(j)]).size() >= 2;
+    const Eigen::Vector3d& a = x[static_cast<size_t>(i)];
+    const Eigen::Vector3d& b = x[static_cast<size_t>(j)];
+    if ((a.cwiseMax(b).array() < grid.lo.array()).any() || (a.cwiseMin(b).array() > grid.hi.array()).any()) return false;  // off the grid
+    // A bond whose ends lie in neighbouring cells (most) can only reach the triangles of the cells around the
+    // first: none there, no crossing. (Cells are clamped to the grid, which only widens what is looked at.)
+    const Eigen::Vector3i ca = grid.cell_of(a), cb = grid.cell_of(b);
+    if ((ca - cb).cwiseAbs().maxCoeff() <= 1 && !grid.near[static_cast<size_t>(grid.index(ca.x(), ca.y(), ca.z()))]) return false;
+    return crossings(grid, a, b).size() >= 2;
   });
 }
 
