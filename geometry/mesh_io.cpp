@@ -87,18 +87,31 @@ aiMesh* make_mesh(const TriSurface& s, const std::vector<int>& faces, const std:
   return mesh;
 }
 
+// Whether face f has no area once its corners are rounded to the files' single precision: a sliver whose
+// corners meet or lie on one line (its angle below 1e-6 rad, where a reader's single-precision cross product
+// can be zero), which readers take for a line or a point (assimp) or refuse. Such faces are not written.
+bool degenerate_in_float(const TriSurface& s, int f) {
+  Eigen::Vector3f p[3];
+  for (int k = 0; k < 3; ++k) p[k] = s.V.row(s.F(f, k)).cast<float>().transpose();
+  const Eigen::Vector3f e1 = p[1] - p[0], e2 = p[2] - p[0];
+  const Eigen::Vector3f cross = e1.cross(e2);  // as a reader computes it, in single precision
+  const Eigen::Vector3d e1d = e1.cast<double>(), e2d = e2.cast<double>();
+  return p[0] == p[1] || p[1] == p[2] || p[0] == p[2] || cross.squaredNorm() == 0 ||
+         !(e1d.cross(e2d).norm() > 1e-6 * e1d.norm() * e2d.norm());
+}
+
 std::unique_ptr<aiScene> make_scene(const TriSurface& s, bool mesh_per_tag) {
   std::vector<std::vector<int>> groups;
   std::vector<std::string> names;
   if (mesh_per_tag) {
     groups.resize(s.tag_names.size());
-    for (int f = 0; f < s.num_faces(); ++f) groups[s.face_tag.size() ? s.face_tag(f) : 0].push_back(f);
     names = s.tag_names;
   } else {
-    groups.emplace_back(s.num_faces());
-    for (int f = 0; f < s.num_faces(); ++f) groups[0][f] = f;
+    groups.resize(1);
     names = {"needle"};
   }
+  for (int f = 0; f < s.num_faces(); ++f)
+    if (!degenerate_in_float(s, f)) groups[mesh_per_tag && s.face_tag.size() ? s.face_tag(f) : 0].push_back(f);
   auto scene = std::make_unique<aiScene>();
   std::vector<aiMesh*> meshes;
   std::vector<aiMaterial*> materials;
