@@ -92,11 +92,21 @@ void print_table(const TipReport& r) {
   }
 }
 
+// The reported cross-sections over a length, refused before any work when there would be too many.
+void check_section_count(double length_mm, double step_mm) {
+  constexpr double kMaxSections = 1.0e4;
+  const double sections = length_mm / step_mm;
+  NEEDLE_REQUIRE(sections <= kMaxSections, fmt::format("--section-step-mm {} makes about {:.3g} cross-sections over {:.3g} mm (limit {:.0e}): "
+                                                       "use a larger step (default 0.5)",
+                                                       step_mm, sections, length_mm, kMaxSections));
+}
+
 void analyze_file(const TipOptions& o) {
   const TriSurface surface = read_surface(o.analyze_file);
   const Eigen::Vector3d tip = most_distal_point(surface);
   std::vector<double> stations;
   const double min_x = surface.V.col(0).minCoeff();
+  check_section_count(tip.x() - min_x, o.section_step_mm);
   for (double x = tip.x() - 0.25 * o.section_step_mm; x > min_x; x -= o.section_step_mm) stations.push_back(x);
   std::reverse(stations.begin(), stations.end());
   json faces = json::object();
@@ -131,6 +141,7 @@ void run_tip(const TipOptions& o) {
     return;
   }
   const GrindingRecipe recipe = recipe_from_source(o.source);
+  check_section_count(recipe.rod.length_mm, o.section_step_mm);
   // Check output paths before any work, so a bad path costs nothing and writes nothing.
   SurfaceFormat format{};
   if (!o.out_file.empty()) format = surface_format_from_path(o.out_file, o.ascii_stl);

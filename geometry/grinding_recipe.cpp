@@ -61,6 +61,11 @@ GrindingRecipe preset_recipe(const std::string& name) {
   return recipe;
 }
 
+namespace {
+constexpr double kMaxRodSegments = 2.0e4;   // around the rod, as the rings along it
+constexpr double kMaxRodTriangles = 2.0e7;  // the whole tessellation, before the booleans
+}  // namespace
+
 void validate_recipe(const GrindingRecipe& recipe) {
   const double diameter = recipe.rod.diameter_mm;
   const double radius = 0.5 * diameter;
@@ -85,6 +90,20 @@ void validate_recipe(const GrindingRecipe& recipe) {
   NEEDLE_REQUIRE(recipe.rod.length_mm / recipe.tessellation.axial_spacing_mm <= 20000.0,
                  fmt::format("axial spacing {} mm is too fine for a {} mm rod (over 20000 rings)",
                              recipe.tessellation.axial_spacing_mm, recipe.rod.length_mm));
+  {
+    // The work the tessellation makes, estimated before any: the segments around the rod that the chord tolerance
+    // asks for, times the rings along it (an upper bound). A tolerance of 1e-12 mm asked for 1.8 million segments
+    // and grew past 8 GB.
+    const double segments = 2.0 * M_PI / (2.0 * std::acos(1.0 - recipe.tessellation.chord_tolerance_mm / radius));
+    const double rings = recipe.rod.length_mm / recipe.tessellation.shaft_axial_spacing_mm +
+                         recipe.rod.length_mm / recipe.tessellation.axial_spacing_mm;
+    const double triangles = 2.0 * segments * rings;
+    NEEDLE_REQUIRE(segments <= kMaxRodSegments && triangles <= kMaxRodTriangles,
+                   fmt::format("chord tolerance {} mm makes about {:.3g} segments around the rod and {:.3g} triangles (limits {:.0e} "
+                               "and {:.0e}): use a larger --chord-tolerance-mm (the default 0.001 makes {:.0f} segments)",
+                               recipe.tessellation.chord_tolerance_mm, segments, triangles, kMaxRodSegments, kMaxRodTriangles,
+                               std::ceil(M_PI / std::acos(1.0 - 1e-3 / radius))));
+  }
   NEEDLE_REQUIRE(recipe.tessellation.min_segments_per_arc >= 1 && recipe.tessellation.min_segments_per_arc <= 256,
                  fmt::format("min segments per arc must be in [1, 256], got {}",
                              recipe.tessellation.min_segments_per_arc));

@@ -55,5 +55,16 @@ TEST_CASE("needle tip --d-a writes every format; bad input writes nothing", "[ap
   const auto jpg = run("tip --preset SB --png " + d + "/t.jpg", true);
   CHECK(jpg.exit_code == 2);
   CHECK(jpg.out.find("--png writes a PNG picture and needs a .png file") != std::string::npos);
+  // Absurd work is refused before any, with the estimate and the limit: a chord tolerance of 1e-12 mm asked for
+  // 1.8 million segments around the rod (it grew past 8 GB), a section step of 1e-9 mm for 4e10 sections.
+  const auto chord = run("tip --preset SB --chord-tolerance-mm 1e-12 --out " + d + "/chord.stl", true);
+  CHECK(chord.exit_code == 2);
+  CHECK(chord.out.find("segments around the rod") != std::string::npos);
+  CHECK(chord.out.find("use a larger --chord-tolerance-mm") != std::string::npos);
+  const auto sections = run("tip --preset SB --section-step-mm 1e-9 --out " + d + "/sections.stl", true);
+  CHECK(sections.exit_code == 2);
+  CHECK(sections.out.find("cross-sections over") != std::string::npos);
   CHECK(fs::is_empty(dir));
+  // A fine tolerance within the limits still builds.
+  CHECK(run("tip --preset SB --chord-tolerance-mm 1e-4 --out " + d + "/fine.stl").exit_code == 0);
 }
