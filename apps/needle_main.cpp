@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <fmt/format.h>
 #include <sstream>
+#include <string>
 
 #include "apps/material_test_command.h"
 #include "apps/bench_command.h"
@@ -39,6 +40,17 @@ void refuse_non_finite_numbers(const CLI::App& command) {
   }
 }
 
+// An error as one line of bounded length: a library's message can carry a whole file (assimp echoed 2 MB of a
+// broken ASCII STL) or line breaks; the line keeps its first 400 characters and says how many it left out.
+std::string one_line(const char* what) {
+  constexpr size_t kMaxChars = 400;
+  std::string text(what);
+  for (char& c : text)
+    if (c == '\n' || c == '\r' || c == '\t') c = ' ';
+  if (text.size() <= kMaxChars) return text;
+  return fmt::format("{} ... ({} more characters left out)", text.substr(0, kMaxChars), text.size() - kMaxChars);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -61,16 +73,16 @@ int main(int argc, char** argv) {
     return app.exit(e);  // --help: the help text, exit 0
   } catch (const CLI::ParseError& e) {
     // A flag the command does not know, a value that does not convert, a required flag missing: the project's one line.
-    fmt::print(stderr, "needle: error: {} (--help lists the flags)\n", e.what());
+    fmt::print(stderr, "needle: error: {} (--help lists the flags)\n", one_line(e.what()));
     return 2;
   } catch (const needle::InputError& e) {
-    fmt::print(stderr, "needle: error: {}\n", e.what());
+    fmt::print(stderr, "needle: error: {}\n", one_line(e.what()));
     return 2;
   } catch (const needle::SolverError& e) {
-    fmt::print(stderr, "needle: the solver stopped: {}\n", e.what());
+    fmt::print(stderr, "needle: the solver stopped: {}\n", one_line(e.what()));
     return 3;
   } catch (const std::exception& e) {
-    fmt::print(stderr, "needle: failed: {}\n", e.what());
+    fmt::print(stderr, "needle: failed: {}\n", one_line(e.what()));
     return 1;
   }
   return 0;

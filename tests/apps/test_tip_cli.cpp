@@ -1,6 +1,7 @@
 // `needle tip` end to end, as a user runs it: exit codes, JSON fields, files written or not.
 #include <catch2/catch.hpp>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include "cli_run.h"
 
@@ -65,6 +66,20 @@ TEST_CASE("needle tip --d-a writes every format; bad input writes nothing", "[ap
   CHECK(sections.exit_code == 2);
   CHECK(sections.out.find("cross-sections over") != std::string::npos);
   CHECK(fs::is_empty(dir));
+  // A library's error that echoes the file (assimp on an ASCII STL with one bad vertex: 2 MB) is cut to one bounded line.
+  {
+    std::ofstream bad(dir / "bad.stl");
+    bad << "solid x\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n   vertex 0 1 BAD\n  endloop\n endfacet\n";
+    for (int k = 0; k < 20000; ++k)
+      bad << " facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n   vertex 0 1 0\n  endloop\n endfacet\n";
+    bad << "endsolid x\n";
+  }
+  const auto echoed = run("tip --analyze " + d + "/bad.stl", true);
+  CHECK(echoed.exit_code == 2);
+  CHECK(echoed.out.find("needle: error: cannot read") != std::string::npos);
+  CHECK(echoed.out.find("more characters left out)") != std::string::npos);
+  CHECK(echoed.out.size() < 1000);
+  fs::remove(dir / "bad.stl");
   // A fine tolerance within the limits still builds.
   CHECK(run("tip --preset SB --chord-tolerance-mm 1e-4 --out " + d + "/fine.stl").exit_code == 0);
 }
