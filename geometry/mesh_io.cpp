@@ -18,6 +18,7 @@ namespace needle {
 namespace fs = std::filesystem;
 
 SurfaceFormat surface_format_from_path(const std::string& path, bool ascii_stl) {
+  NEEDLE_REQUIRE(!fs::is_directory(path), fmt::format("'{}' is a folder: give the surface file's name, e.g. {}/tip.stl", path, path));
   std::string ext = fs::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
   if (ext == ".stl") return ascii_stl ? SurfaceFormat::stl_ascii : SurfaceFormat::stl_binary;
@@ -164,12 +165,17 @@ std::vector<std::string> write_surface(const TriSurface& surface, const std::str
     throw std::runtime_error(fmt::format("could not write '{}': {}", path, exporter.GetErrorString()));
   }
   std::vector<std::string> written;
-  for (const std::string& file : sidecars)
-    if (fs::exists(fs::path(scratch) / file)) {
-      commit_scratch_file(scratch, file, target.parent_path().string());
-      written.push_back((target.parent_path() / file).string());
-    }
-  commit_scratch_file(scratch, name, target.parent_path().string());
+  try {
+    for (const std::string& file : sidecars)
+      if (fs::exists(fs::path(scratch) / file)) {
+        commit_scratch_file(scratch, file, target.parent_path().string());
+        written.push_back((target.parent_path() / file).string());
+      }
+    commit_scratch_file(scratch, name, target.parent_path().string());
+  } catch (...) {
+    fs::remove_all(scratch);
+    throw;
+  }
   written.push_back(path);
   fs::remove_all(scratch);
   return written;

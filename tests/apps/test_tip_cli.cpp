@@ -80,6 +80,13 @@ TEST_CASE("needle tip --d-a writes every format; bad input writes nothing", "[ap
   CHECK(echoed.out.find("more characters left out)") != std::string::npos);
   CHECK(echoed.out.size() < 1000);
   fs::remove(dir / "bad.stl");
+  // --out naming a folder is refused before any work, and no scratch folder is left (it was, after a filesystem error).
+  fs::create_directories(dir / "folder.stl");
+  const auto folder = run("tip --preset SB --out " + d + "/folder.stl", true);
+  CHECK(folder.exit_code == 2);
+  CHECK(folder.out.find("is a folder: give the surface file's name") != std::string::npos);
+  for (const auto& entry : fs::directory_iterator(dir)) CHECK(entry.path().filename().string().rfind(".needle-partial", 0) != 0);
+  fs::remove_all(dir / "folder.stl");
   // A fine tolerance within the limits still builds.
   CHECK(run("tip --preset SB --chord-tolerance-mm 1e-4 --out " + d + "/fine.stl").exit_code == 0);
 }

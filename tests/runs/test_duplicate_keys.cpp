@@ -1,5 +1,6 @@
 // A key given twice in one JSON object is refused in every file the toolkit reads (scenes, recipes, tissue
 // cards, summaries), naming the key (and, in scenes, both lines): nlohmann keeps the last one without a word.
+// A scene nested thousands of levels deep is refused at once, at its line.
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
@@ -42,4 +43,18 @@ TEST_CASE("A key given twice in one object is refused in scenes, recipes, tissue
   CHECK(refusal([&] { needle::read_material_file(card); }).find("duplicate key 'E_MPa'") != std::string::npos);
   const std::string summary = file_with("needle_dup_summary.json", R"({"runs": [{"a": 1}, {"a": 2, "a": 3}]})");
   CHECK(refusal([&] { needle::read_json_file(summary, "summary"); }).find("duplicate key 'runs.a'") != std::string::npos);
+}
+
+TEST_CASE("A scene nested deeper than 64 levels is refused at once, a real scene's depth is not", "[apps][scene]") {
+  const auto nested = [](int depth) {
+    std::string text;
+    for (int k = 0; k < depth; ++k) text += "{\"a\":";
+    text += "1";
+    for (int k = 0; k < depth; ++k) text += "}";
+    return text;
+  };
+  // 50 000 levels: refused on reaching the 65th (it took 18 s to get to the unknown key before, building paths).
+  CHECK(refusal([&] { needle::parse_scene(nested(50000), "deep.json"); }) == "deep.json:1: nested deeper than 64 levels (scenes and recipes nest a few)");
+  // At 64 the parser reads on and the scene reader names the unknown key.
+  CHECK(refusal([&] { needle::parse_scene(nested(64), "deep.json"); }).find("a: unknown key") != std::string::npos);
 }
