@@ -5,6 +5,7 @@
 #include <CGAL/Polygon_mesh_processing/clip.h>
 #include <CGAL/Polygon_mesh_processing/corefinement.h>
 #include <CGAL/Polygon_mesh_processing/repair_degeneracies.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Surface_mesh.h>
 #include <algorithm>
 #include <chrono>
@@ -91,6 +92,8 @@ void clip_by_plane(Mesh& mesh, const Eigen::Vector3d& normal, const Eigen::Vecto
 }
 
 }  // namespace
+
+bool surface_self_intersects(const TriSurface& surface) { return PMP::does_self_intersect(to_cgal(surface)); }
 
 CadSolid build_cad_solid(const GrindingRecipe& recipe, bool half_model) {
   const auto start = std::chrono::steady_clock::now();

@@ -11,6 +11,7 @@
 #include <random>
 
 #include "core/input_error.h"
+#include "geometry/cad_solid.h"
 #include "geometry/surface_measures.h"
 #include "geometry/tag_colors.h"
 
@@ -232,6 +233,9 @@ TriSurface read_surface(const std::string& path) {
                              topology.describe()));
   NEEDLE_REQUIRE(enclosed_volume_mm3(surface) > 0,
                  fmt::format("'{}' encloses no positive volume: its triangles face inward", path));
+  NEEDLE_REQUIRE(!surface_self_intersects(surface),
+                 fmt::format("'{}' intersects itself (triangles of it cross): it bounds no single solid, so its volume and "
+                             "sections would mean nothing and it cannot be meshed", path));
   return surface;
 }
 

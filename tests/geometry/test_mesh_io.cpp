@@ -118,4 +118,26 @@ TEST_CASE("open, unreadable and inside-out surfaces are refused", "[geometry][io
   CHECK_THROWS_AS(read_surface((dir / "garbage.stl").string()), InputError);
   CHECK_THROWS_WITH(read_surface((dir / "missing.stl").string()), Catch::Contains("no such file"));
   CHECK_THROWS_WITH(surface_format_from_path("tip.step"), Catch::Contains("cannot tell the surface format"));
+  // Two unit cubes overlapping by half a unit in x and y: each edge has two triangles, every one faces out, the
+  // divergence theorem gives 2 where the solid is 1.875; the surface crosses itself and is refused.
+  {
+    std::ofstream obj((dir / "cubes.obj").string());
+    for (const double shift : {0.0, 0.5}) {
+      for (int k = 0; k < 8; ++k) obj << "v " << shift + (k & 1) << " " << shift + ((k >> 1) & 1) << " " << ((k >> 2) & 1) << "\n";
+    }
+    const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+    for (const int base : {1, 9})
+      for (const auto& q : quads)
+        obj << "f " << base + q[0] << " " << base + q[1] << " " << base + q[2] << "\nf " << base + q[0] << " " << base + q[2] << " "
+            << base + q[3] << "\n";
+  }
+  CHECK_THROWS_WITH(read_surface((dir / "cubes.obj").string()), Catch::Contains("intersects itself"));
+  // One of them alone is a closed box of volume 1, accepted.
+  {
+    std::ofstream obj((dir / "cube.obj").string());
+    for (int k = 0; k < 8; ++k) obj << "v " << (k & 1) << " " << ((k >> 1) & 1) << " " << ((k >> 2) & 1) << "\n";
+    const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+    for (const auto& q : quads) obj << "f " << 1 + q[0] << " " << 1 + q[1] << " " << 1 + q[2] << "\nf " << 1 + q[0] << " " << 1 + q[2] << " " << 1 + q[3] << "\n";
+  }
+  CHECK(enclosed_volume_mm3(read_surface((dir / "cube.obj").string())) == Approx(1.0));
 }
