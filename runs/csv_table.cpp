@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "core/input_error.h"
+#include "core/input_file.h"
 
 namespace needle {
 namespace {
@@ -40,6 +41,7 @@ std::vector<double> CsvTable::column(const std::string& name) const {
 }
 
 CsvTable read_csv_table(const std::string& path) {
+  refuse_folder_as_file(path, "table");
   std::ifstream in(path);
   NEEDLE_REQUIRE(in.good(), fmt::format("cannot read '{}'", path));
   CsvTable table;

@@ -7,10 +7,12 @@
 #include <vector>
 
 #include "core/input_error.h"
+#include "core/input_file.h"
 
 namespace needle {
 
 nlohmann::json read_json_file(const std::string& path, const std::string& what) {
+  refuse_folder_as_file(path, what);
   std::ifstream in(path);
   NEEDLE_REQUIRE(in.good(), fmt::format("cannot read the {} '{}'", what, path));
   try {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/input_error.h"
+#include "core/input_file.h"
 
 namespace needle {
 namespace {
@@ -141,6 +142,7 @@ JsonDocument parse_json_with_lines(const std::string& text, const std::string& s
 }
 
 JsonDocument read_json_with_lines(const std::string& path) {
+  refuse_folder_as_file(path, "JSON file");
   std::ifstream in(path, std::ios::binary);
   NEEDLE_REQUIRE(in, fmt::format("cannot read '{}'", path));
   std::stringstream text;

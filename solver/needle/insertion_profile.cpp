@@ -14,6 +14,9 @@ void InsertionProfile::validate(const std::string& where) const {
   NEEDLE_REQUIRE(std::isfinite(speed_mm_per_ms) && speed_mm_per_ms > 0,
                  fmt::format("{}: the insertion speed must be positive (got {} m/s)", where, speed_mm_per_ms));
   NEEDLE_REQUIRE(std::isfinite(travel_mm) && travel_mm > 0, fmt::format("{}: travel_mm must be positive (got {})", where, travel_mm));
+  // No biopsy needle is longer than a metre: a travel beyond it is a typo (1e9 mm started a run of 1e11 steps).
+  constexpr double kMaxTravelMm = 1000.0;
+  NEEDLE_REQUIRE(travel_mm <= kMaxTravelMm, fmt::format("{}: travel {} mm is beyond any needle (at most {} mm)", where, travel_mm, kMaxTravelMm));
   NEEDLE_REQUIRE(std::isfinite(decel_time_ms) && decel_time_ms >= 0,
                  fmt::format("{}: decel_time_ms must be zero or positive (got {})", where, decel_time_ms));
   NEEDLE_REQUIRE(std::isfinite(hold_ms) && hold_ms >= 0, fmt::format("{}: hold_ms must be zero or positive (got {})", where, hold_ms));

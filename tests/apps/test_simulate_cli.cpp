@@ -302,6 +302,11 @@ TEST_CASE("A number flag given NaN or infinity is refused before anything runs, 
     CHECK(std::count(r.out.begin(), r.out.end(), '\n') == 1);
     CHECK(!fs::exists(dir / "out"));
   }
+  // A finite but absurd travel: refused as well, before any work (1e9 mm started a run).
+  const auto far = run("run --preset SB --travel-mm 1e9 --out " + (dir / "out").string(), true);
+  CHECK(far.exit_code == 2);
+  CHECK(far.out.find("travel 1000000000 mm is beyond any needle (at most 1000 mm)") != std::string::npos);
+  CHECK(!fs::exists(dir / "out"));
 }
 
 TEST_CASE("Unknown flags, values that do not convert and negative counts get the project's one line and exit 2", "[apps][sim]") {

@@ -87,6 +87,12 @@ TEST_CASE("needle tip --d-a writes every format; bad input writes nothing", "[ap
   CHECK(folder.out.find("is a folder: give the surface file's name") != std::string::npos);
   for (const auto& entry : fs::directory_iterator(dir)) CHECK(entry.path().filename().string().rfind(".needle-partial", 0) != 0);
   fs::remove_all(dir / "folder.stl");
+  // A folder where a recipe file is named: the project's words, not the stream's ("basic_filebuf::underflow").
+  fs::create_directories(dir / "recipe_folder");
+  const auto recipe_folder = run("tip --recipe " + d + "/recipe_folder --out " + d + "/r.stl", true);
+  CHECK(recipe_folder.exit_code == 2);
+  CHECK(recipe_folder.out.find("cannot read the recipe '" + d + "/recipe_folder': it is a folder, not a file") != std::string::npos);
+  fs::remove_all(dir / "recipe_folder");
   // A fine tolerance within the limits still builds.
   CHECK(run("tip --preset SB --chord-tolerance-mm 1e-4 --out " + d + "/fine.stl").exit_code == 0);
 }

@@ -58,3 +58,13 @@ TEST_CASE("A scene nested deeper than 64 levels is refused at once, a real scene
   // At 64 the parser reads on and the scene reader names the unknown key.
   CHECK(refusal([&] { needle::parse_scene(nested(64), "deep.json"); }).find("a: unknown key") != std::string::npos);
 }
+
+TEST_CASE("A folder named as a scene, a card or a result file is refused in the project's words", "[apps][scene]") {
+  const std::filesystem::path folder = std::filesystem::temp_directory_path() / "needle_folder_not_file.json";
+  std::filesystem::create_directories(folder);
+  CHECK(refusal([&] { needle::read_scene(folder.string()); }) == "cannot read the JSON file '" + folder.string() + "': it is a folder, not a file");
+  CHECK(refusal([&] { needle::read_material_file(folder.string()); }).find("it is a folder, not a file") != std::string::npos);
+  CHECK(refusal([&] { needle::read_json_file(folder.string(), "summary"); }) ==
+        "cannot read the summary '" + folder.string() + "': it is a folder, not a file");
+  std::filesystem::remove_all(folder);
+}
