@@ -17,6 +17,7 @@
 #include "apps/stiffness_command.h"
 #include "apps/tip_command.h"
 #include "core/input_error.h"
+#include "core/interrupt.h"
 #include "core/solver_error.h"
 
 namespace {
@@ -78,6 +79,9 @@ int main(int argc, char** argv) {
   } catch (const needle::InputError& e) {
     fmt::print(stderr, "needle: error: {}\n", one_line(e.what()));
     return 2;
+  } catch (const needle::Interrupted& e) {
+    fmt::print(stderr, "needle: {}\n", one_line(e.what()));
+    return 128 + e.signal;
   } catch (const needle::SolverError& e) {
     fmt::print(stderr, "needle: the solver stopped: {}\n", one_line(e.what()));
     return 3;

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <fstream>
 
+#include "core/interrupt.h"
 #include "core/parallel.h"
 #include "core/solver_error.h"
 
@@ -13,8 +14,11 @@ void drive_run(const Scene& scene, const RunOptions& o, const std::function<std:
   using Clock = std::chrono::steady_clock;
   const ThreadLimit threads(o.threads >= 0 ? o.threads : scene.solver.threads);
   const auto start = Clock::now();
+  const InterruptWatch interrupts;  // Ctrl-C or SIGTERM: stop between steps and write what there is
   const std::unique_ptr<RunModel> built = build();
   RunModel& model = *built;
+  if (const int signal = interrupts.signal())
+    throw Interrupted(signal, fmt::format("interrupted by {} while the model was built; nothing written", signal_name(signal)));
   if (!o.quiet && !o.note.empty()) fmt::print("{}\n", o.note);
   RunFolder folder(o.out_dir, o.overwrite);
   std::filesystem::create_directories(folder.path("frames"));
@@ -48,6 +52,12 @@ void drive_run(const Scene& scene, const RunOptions& o, const std::function<std:
         ++next_frame;
       }
       progress.update(model.time_ms(), model.steps(), "ms");
+      if (const int signal = interrupts.signal()) {
+        status = "interrupted";
+        reason = fmt::format("interrupted by {} at t = {:.6g} ms of {:.6g}", signal_name(signal), model.time_ms(), end_ms);
+        model.record();
+        break;
+      }
     }
   } catch (const SolverError& e) {
     status = "stopped";
@@ -86,6 +96,7 @@ void drive_run(const Scene& scene, const RunOptions& o, const std::function<std:
   if (!o.quiet)
     fmt::print("{} {}: deflection {:.6g} mm, {}, {:.1f} s -> {}\n", model.needle_name(), status, deflection, model.print_steps(), solve_s,
                folder.final_path().string());
+  if (status == "interrupted") throw Interrupted(interrupts.signal(), reason + fmt::format(" (what was written so far is in {})", o.out_dir));
   if (status != "finished" && o.throw_on_stop) throw SolverError(reason + fmt::format(" (what was written so far is in {})", o.out_dir));
 }
 

@@ -328,3 +328,32 @@ TEST_CASE("Unknown flags, values that do not convert and negative counts get the
   }
   CHECK(run("run --help").exit_code == 0);
 }
+
+TEST_CASE("Ctrl-C during a run writes what there is, marked interrupted, exits 130 and leaves no scratch folder", "[apps][sim]") {
+  // The run (sb_quick: about 15 s) is sent SIGINT once its loop has written its first history rows.
+  const fs::path dir = fresh_folder("interrupt");
+  const fs::path out = dir / "run", partial = dir / ".run.partial" / "history.csv";
+  const std::string command = fmt::format(
+      "{} simulate {}/data/scenes/sb_quick.json --out {} --quiet 2>&1 & pid=$!; "
+      "for i in $(seq 300); do [ -s {} ] && break; sleep 0.05; done; sleep 0.5; kill -INT $pid; wait $pid; echo \"exit $?\"",
+      NEEDLE_BINARY, NEEDLE_SOURCE_DIR, out.string(), partial.string());
+  FILE* pipe = popen(command.c_str(), "r");
+  REQUIRE(pipe);
+  std::string text;
+  char buffer[4096];
+  size_t n;
+  while ((n = fread(buffer, 1, sizeof buffer, pipe)) > 0) text.append(buffer, n);
+  pclose(pipe);
+  INFO(text);
+  CHECK(text.find("needle: interrupted by SIGINT at t = ") != std::string::npos);
+  CHECK(text.find("exit 130") != std::string::npos);
+  REQUIRE(fs::exists(out / "summary.json"));
+  std::ifstream summary_file(out / "summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(summary_file);
+  CHECK(summary["status"] == "interrupted");
+  CHECK(summary["reason"].get<std::string>().rfind("interrupted by SIGINT at t = ", 0) == 0);
+  CHECK(summary["time_ms"].get<double>() > 0);
+  CHECK(summary["time_ms"].get<double>() < 4.125);
+  CHECK(needle::read_csv_table((out / "history.csv").string()).rows.size() >= 2);
+  for (const auto& entry : fs::directory_iterator(dir)) CHECK(entry.path().filename().string().find("partial") == std::string::npos);
+}
