@@ -18,7 +18,7 @@ nlohmann::json read_json_file(const std::string& path, const std::string& what) 
   try {
     return parse_json_refusing_duplicates(in, path);
   } catch (const nlohmann::json::exception& e) {
-    throw InputError(fmt::format("{}: not valid JSON ({})", path, e.what()));
+    throw InputError(fmt::format("{}: not valid JSON ({})", path, json_error_words(e)));
   }
 }
 
@@ -57,6 +57,15 @@ nlohmann::json parse_json_refusing_duplicates(std::istream& in, const std::strin
     return true;
   };
   return json::parse(in, check);
+}
+
+std::string json_error_words(const std::exception& e) {
+  const std::string what = e.what();
+  if (what.rfind("[json.exception.", 0) == 0) {
+    const size_t end = what.find("] ");
+    if (end != std::string::npos) return what.substr(end + 2);
+  }
+  return what;
 }
 
 double number_or_nan(const nlohmann::json& j, const char* key) {

@@ -14,6 +14,10 @@ nlohmann::json read_json_file(const std::string& path, const std::string& what);
 // nlohmann's exceptions, for the caller to word.
 nlohmann::json parse_json_refusing_duplicates(std::istream& in, const std::string& path);
 
+// A parse error of nlohmann's in the project's words: its message without the "[json.exception.parse_error.101] "
+// tag (e.g. "number overflow parsing '1e999'").
+std::string json_error_words(const std::exception& e);
+
 // j[key] when it is a number, NaN otherwise (a missing or null field).
 double number_or_nan(const nlohmann::json& j, const char* key);
 

@@ -10,6 +10,7 @@
 
 #include "core/input_error.h"
 #include "core/input_file.h"
+#include "runs/json_file.h"
 
 namespace needle {
 namespace {
@@ -72,7 +73,7 @@ class LineTrackingBuilder : public nlohmann::json_sax<json> {
     return true;
   }
   bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception& e) override {
-    throw InputError(fmt::format("{}:{}: not valid JSON ({})", doc_.source, line_, e.what()));
+    throw InputError(fmt::format("{}:{}: not valid JSON ({})", doc_.source, line_, json_error_words(e)));
   }
 
  private:

@@ -35,7 +35,7 @@ TissueMaterial read_material_file(const std::string& path) {
   try {
     json = parse_json_refusing_duplicates(in, path);
   } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(fmt::format("{}: not valid JSON ({})", path, e.what()));
+    throw InputError(fmt::format("{}: not valid JSON ({})", path, json_error_words(e)));
   }
   return material_from_json(json, path);
 }

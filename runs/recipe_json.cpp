@@ -94,7 +94,7 @@ GrindingRecipe read_recipe_file(const std::string& path) {
   try {
     root = parse_json_refusing_duplicates(in, path);
   } catch (const json::parse_error& e) {
-    throw InputError(fmt::format("{}: not valid JSON: {}", path, e.what()));
+    throw InputError(fmt::format("{}: not valid JSON: {}", path, json_error_words(e)));
   }
   return recipe_from_json(root, path);
 }

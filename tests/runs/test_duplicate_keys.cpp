@@ -68,3 +68,12 @@ TEST_CASE("A folder named as a scene, a card or a result file is refused in the 
         "cannot read the summary '" + folder.string() + "': it is a folder, not a file");
   std::filesystem::remove_all(folder);
 }
+
+TEST_CASE("A JSON error reads in the project's words, without the parser's exception tag", "[apps][scene]") {
+  CHECK(refusal([] { needle::parse_scene("{\"motion\": {\"travel_mm\": 1e999}}", "ovf.json"); }) ==
+        "ovf.json:1: not valid JSON (number overflow parsing '1e999')");
+  const std::string recipe = file_with("needle_bad_recipe.json", "{\"name\": \"x\",, }");
+  const std::string words = refusal([&] { needle::read_recipe_file(recipe); });
+  CHECK(words.rfind(recipe + ": not valid JSON: parse error at line 1", 0) == 0);
+  CHECK(words.find("json.exception") == std::string::npos);
+}
