@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+#include <new>
 #include <fmt/format.h>
 #include <sstream>
 #include <string>
@@ -85,6 +87,13 @@ int main(int argc, char** argv) {
   } catch (const needle::SolverError& e) {
     fmt::print(stderr, "needle: the solver stopped: {}\n", one_line(e.what()));
     return 3;
+  } catch (const std::filesystem::filesystem_error& e) {
+    // The environment, not the input: a folder that cannot be made or written, a disk that is full.
+    fmt::print(stderr, "needle: cannot read or write a file: {}\n", one_line(e.what()));
+    return 4;
+  } catch (const std::bad_alloc&) {
+    fmt::print(stderr, "needle: out of memory\n");
+    return 4;
   } catch (const std::exception& e) {
     fmt::print(stderr, "needle: failed: {}\n", one_line(e.what()));
     return 1;

@@ -1,4 +1,5 @@
 // `needle tip` end to end, as a user runs it: exit codes, JSON fields, files written or not.
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
@@ -93,6 +94,11 @@ TEST_CASE("needle tip --d-a writes every format; bad input writes nothing", "[ap
   CHECK(recipe_folder.exit_code == 2);
   CHECK(recipe_folder.out.find("cannot read the recipe '" + d + "/recipe_folder': it is a folder, not a file") != std::string::npos);
   fs::remove_all(dir / "recipe_folder");
+  // The environment refusing a write (here /proc, where no folder can be made) is exit 4, in one line, not a crash.
+  const auto proc = run("tip --preset SB --out /proc/needle_tip.stl", true);
+  CHECK(proc.exit_code == 4);
+  CHECK(proc.out.rfind("needle: cannot read or write a file: ", 0) == 0);
+  CHECK(std::count(proc.out.begin(), proc.out.end(), '\n') == 1);
   // A fine tolerance within the limits still builds.
   CHECK(run("tip --preset SB --chord-tolerance-mm 1e-4 --out " + d + "/fine.stl").exit_code == 0);
 }
