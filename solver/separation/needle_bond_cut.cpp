@@ -135,6 +135,10 @@ std::vector<double> NeedleBondCut::crossings(const Grid& grid, const Eigen::Vect
   const Eigen::Vector3d lo = a.cwiseMin(b), hi = a.cwiseMax(b);
   if ((hi.array() < grid.lo.array()).any() || (lo.array() > grid.hi.array()).any()) return s;
   const Eigen::Vector3i c0 = grid.cell_of(lo), c1 = grid.cell_of(hi);
+  // A segment within two cells along each axis (most bonds) lies in the cells around its lowest one: with no
+  // triangle there, no crossing, and the cells are not walked. (Cells are clamped to the grid, which only
+  // widens what is looked at.)
+  if ((c1 - c0).maxCoeff() <= 1 && !grid.near[static_cast<size_t>(grid.index(c0.x(), c0.y(), c0.z()))]) return s;
   const Eigen::Vector3d d = b - a;
   const double length = d.norm();
   for (int i = c0.x(); i <= c1.x(); ++i)
@@ -162,14 +166,7 @@ std::vector<std::int64_t> NeedleBondCut::bonds_through_needle(const BondNetwork&
                                                               const Eigen::MatrixX3d& needle_x) const {
   const Grid grid = build_grid(needle_x);
   return select_intact_bonds(bonds, [&](std::int32_t i, std::int32_t j) {
-    const Eigen::Vector3d& a = x[static_cast<size_t>(i)];
-    const Eigen::Vector3d& b = x[static_cast<size_t>(j)];
-    if ((a.cwiseMax(b).array() < grid.lo.array()).any() || (a.cwiseMin(b).array() > grid.hi.array()).any()) return false;  // off the grid
-    // A bond whose ends lie in neighbouring cells (most) can only reach the triangles of the cells around the
-    // first: none there, no crossing. (Cells are clamped to the grid, which only widens what is looked at.)
-    const Eigen::Vector3i ca = grid.cell_of(a), cb = grid.cell_of(b);
-    if ((ca - cb).cwiseAbs().maxCoeff() <= 1 && !grid.near[static_cast<size_t>(grid.index(ca.x(), ca.y(), ca.z()))]) return false;
-    return crossings(grid, a, b).size() >= 2;
+    return crossings(grid, x[static_cast<size_t>(i)], x[static_cast<size_t>(j)]).size() >= 2;
   });
 }
 

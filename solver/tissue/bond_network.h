@@ -2,9 +2,7 @@
 // Bonds: the particle pairs that interact, i.e. j in the support covering i or i in the support covering
 // j. A bond names its (up to two) shape-function entries; breaking it cuts both, so the pair leaves each
 // other's supports and the rows are rebuilt without it.
-#include <algorithm>
 #include <cstdint>
-#include <mutex>
 #include <utility>
 #include <vector>
 
@@ -50,22 +48,10 @@ BondNetwork build_bond_network(const RkShapeFunctions& rk);
 // compact pair list (selected must only read).
 template <class Selected>
 std::vector<std::int64_t> select_intact_bonds(const BondNetwork& bonds, const Selected& selected) {
-  std::mutex merge;
-  std::vector<std::pair<std::int64_t, std::vector<std::int64_t>>> chunks;
-  parallel_for(static_cast<std::int64_t>(bonds.intact.size()), [&](std::int64_t begin, std::int64_t end) {
-    std::vector<std::int64_t> found;
-    for (std::int64_t k = begin; k < end; ++k) {
-      const IntactPair& pair = bonds.intact[static_cast<size_t>(k)];
-      if (selected(pair.i, pair.j) && !bonds.bonds[static_cast<size_t>(pair.bond)].broken) found.push_back(pair.bond);
-    }
-    if (found.empty()) return;
-    const std::lock_guard<std::mutex> lock(merge);
-    chunks.emplace_back(begin, std::move(found));
+  return parallel_collect<std::int64_t>(static_cast<std::int64_t>(bonds.intact.size()), [&](std::int64_t k, std::vector<std::int64_t>& found) {
+    const IntactPair& pair = bonds.intact[static_cast<size_t>(k)];
+    if (selected(pair.i, pair.j) && !bonds.bonds[static_cast<size_t>(pair.bond)].broken) found.push_back(pair.bond);
   });
-  std::sort(chunks.begin(), chunks.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-  std::vector<std::int64_t> out;
-  for (auto& chunk : chunks) out.insert(out.end(), chunk.second.begin(), chunk.second.end());
-  return out;
 }
 
 // The bonds of a sorted list (intact ones) for which kind(bond) is not 0, with that kind, in the list's order;
@@ -73,23 +59,11 @@ std::vector<std::int64_t> select_intact_bonds(const BondNetwork& bonds, const Se
 template <class Kind>
 std::vector<std::pair<std::int64_t, std::uint8_t>> classify_bonds(const BondNetwork& bonds, const std::vector<std::int32_t>& listed,
                                                                   const Kind& kind) {
-  using Found = std::vector<std::pair<std::int64_t, std::uint8_t>>;
-  std::mutex merge;
-  std::vector<std::pair<std::int64_t, Found>> chunks;
-  parallel_for(static_cast<std::int64_t>(listed.size()), [&](std::int64_t begin, std::int64_t end) {
-    Found found;
-    for (std::int64_t k = begin; k < end; ++k) {
-      const std::int64_t b = listed[static_cast<size_t>(k)];
-      if (const std::uint8_t c = kind(bonds.bonds[static_cast<size_t>(b)])) found.emplace_back(b, c);
-    }
-    if (found.empty()) return;
-    const std::lock_guard<std::mutex> lock(merge);
-    chunks.emplace_back(begin, std::move(found));
+  using Found = std::pair<std::int64_t, std::uint8_t>;
+  return parallel_collect<Found>(static_cast<std::int64_t>(listed.size()), [&](std::int64_t k, std::vector<Found>& found) {
+    const std::int64_t b = listed[static_cast<size_t>(k)];
+    if (const std::uint8_t c = kind(bonds.bonds[static_cast<size_t>(b)])) found.emplace_back(b, c);
   });
-  std::sort(chunks.begin(), chunks.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-  Found out;
-  for (auto& chunk : chunks) out.insert(out.end(), chunk.second.begin(), chunk.second.end());
-  return out;
 }
 
 }  // namespace needle
