@@ -16,6 +16,8 @@
 #include "apps/paper_command.h"
 #include "apps/run_command.h"
 #include "apps/simulate_command.h"
+#include "apps/sweep_command.h"
+#include "apps/optimize_command.h"
 #include "apps/stiffness_command.h"
 #include "apps/tip_command.h"
 #include "core/input_error.h"
@@ -69,6 +71,8 @@ int main(int argc, char** argv) {
   needle::add_paper_command(app);
   needle::add_calibrate_command(app);
   needle::add_bench_command(app);
+  needle::add_sweep_command(app);
+  needle::add_optimize_command(app);
   for (CLI::App* command : app.get_subcommands({})) command->parse_complete_callback([command] { refuse_non_finite_numbers(*command); });
   try {
     app.parse(argc, argv);

@@ -59,7 +59,7 @@ RgbImage draw_line_plot(const LinePlot& plot) {
 
   for (const PlotSeries& s : plot.series) {
     const size_t n = std::min(s.x.size(), s.y.size());
-    for (size_t k = 1; k < n; ++k)
+    for (size_t k = 1; s.line && k < n; ++k)
       if (std::isfinite(s.x[k - 1] + s.y[k - 1] + s.x[k] + s.y[k]))
         image.line(px(s.x[k - 1]), py(s.y[k - 1]), px(s.x[k]), py(s.y[k]), s.color, 2.0, s.dashed ? 8.0 : 0.0);
     if (s.markers)
@@ -73,7 +73,11 @@ RgbImage draw_line_plot(const LinePlot& plot) {
   int y = top + 22;
   for (const PlotSeries& s : plot.series) {
     if (s.label.empty()) continue;
-    image.line(left + 14, y - 5, left + 44, y - 5, s.color, 2.5, s.dashed ? 6.0 : 0.0);
+    if (s.line) image.line(left + 14, y - 5, left + 44, y - 5, s.color, 2.5, s.dashed ? 6.0 : 0.0);
+    if (!s.line || s.markers)
+      for (int a = 0; a < 16; ++a)
+        image.line(left + 29 + 4 * std::cos(a * M_PI / 8), y - 5 + 4 * std::sin(a * M_PI / 8), left + 29 + 4 * std::cos((a + 1) * M_PI / 8),
+                   y - 5 + 4 * std::sin((a + 1) * M_PI / 8), s.color, 1.5);
     text.draw(image, left + 52, y, s.label, ink);
     y += 22;
   }

@@ -13,6 +13,7 @@ struct PlotSeries {
   Rgb color{31, 119, 180};
   bool dashed = false;
   bool markers = false;  // small circles at the points
+  bool line = true;      // false: the points alone (measured values, reference points)
 };
 
 struct LinePlot {

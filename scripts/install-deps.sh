@@ -15,6 +15,7 @@ PACKAGES=(
   nlohmann-json3-dev libcli11-dev libfmt-dev libspdlog-dev
   libpng-dev libfreetype-dev fonts-dejavu-core
   libsuitesparse-dev libspectra-dev
+  libnlopt-dev libnlopt-cxx-dev libopenmpi-dev openmpi-bin
 )
 missing=()
 for p in "${PACKAGES[@]}"; do

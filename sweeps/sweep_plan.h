@@ -1,0 +1,44 @@
+#pragma once
+// A sweep file (docs/sweeps.md) and the cases it makes: the base scene, the design variables as lists or ranges
+// (a full grid over them) or ranges sampled by a seeded Latin hypercube. Everything a bad file can get wrong is
+// found here, before any case runs: unknown keys and variables, empty ranges, values the scene refuses, a sweep
+// whose every tip is infeasible.
+#include <filesystem>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "sweeps/design_case.h"
+
+namespace needle {
+
+struct SweepCase {
+  int index = 0;
+  std::string name;  // case_0007
+  nlohmann::json values = nlohmann::json::object();  // variable -> value
+};
+
+struct SweepPlan {
+  std::string source;                  // the sweep file
+  DesignBase base;
+  std::vector<std::string> variables;  // the table's variable columns (alphabetical)
+  std::string design;                  // "grid" or "latin hypercube, N samples, seed S"
+  std::vector<SweepCase> cases;
+};
+
+// InputError naming the file, line and key for anything wrong.
+SweepPlan read_sweep_file(const std::string& path);
+
+// The plan as stored in the sweep's folder (sweep_plan.json): base, design and cases.
+nlohmann::json sweep_plan_to_json(const SweepPlan& plan);
+
+// Sets up every case's scene and tip before anything runs: InputError naming the case for a value the scene refuses,
+// or when no case's tip can be ground. Returns the infeasible cases' reasons (index -> reason).
+std::map<int, std::string> check_sweep_cases(const SweepPlan& plan);
+
+// The study folder for this plan: created with its plan file (stored_name, e.g. sweep_plan.json), or an existing
+// one whose plan file is the same study (cases may be done already). InputError otherwise, nothing changed.
+void claim_study_folder(const std::filesystem::path& dir, const std::string& stored_name, const nlohmann::json& plan);
+
+}  // namespace needle

@@ -1,0 +1,326 @@
+// Design sweeps and optimisation (sweeps/): the cases a sweep file makes (grid and Latin hypercube against their
+// definitions), where the deflection crosses zero (against the straight line through two cases), one tiny sweep run
+// on worker processes, on MPI ranks and as a batch array with the same table, a sweep interrupted and started again,
+// bad files refused before anything runs, and `needle optimize` with its best tip read back by `needle tip`.
+#include <catch2/catch.hpp>
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fmt/format.h>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "../apps/cli_run.h"
+#include "../apps/run_fixtures.h"
+#include "core/input_error.h"
+#include "runs/csv_table.h"
+#include "sweeps/sweep_plan.h"
+#include "sweeps/sweep_table.h"
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+using namespace needle_test;
+
+namespace {
+
+// A 26 mm multi-bevel tip pushed 0.8 mm into the small block, the fast model: a case takes about a second.
+void write_tiny_scene(const fs::path& dir) {
+  write(dir / "scene.json", R"({"needle": {"d_a_mm": 0, "length_mm": 26, "mesh": {"order": 1, "size_mm": 0.5}},)"
+                            R"("motion": {"accel_time_ms": 0.02, "travel_mm": 0.8}, "cannula": {"enabled": false},)"
+                            R"("tissue": {"enabled": true, "size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4}, "output": {"frames": 0}})");
+}
+
+// Two d_a (one beyond the rod: a tip that cannot be ground) and two frictions: 6 cases, 4 of them run.
+void write_tiny_sweep(const fs::path& dir) {
+  write_tiny_scene(dir);
+  write(dir / "sweep.json", R"({"base": {"scene": "scene.json"}, "model": "fast",)"
+                            R"("variables": {"d_a_mm": {"from": -0.6, "to": 0.4, "count": 3}, "tissue.friction": [0.1, 0.25]}})");
+}
+
+json read_json(const fs::path& path) {
+  std::ifstream in(path);
+  REQUIRE(in.good());
+  return json::parse(in);
+}
+
+// Each case's deflection as written in its record (the exact double), by case name.
+std::map<std::string, double> deflections(const fs::path& out) {
+  std::map<std::string, double> d;
+  const json table = read_json(out / "sweep.json");
+  for (const json& c : table["cases"])
+    if (c["status"] == "finished") d[c["name"].get<std::string>()] = c["deflection_mm"].get<double>();
+  return d;
+}
+
+std::string stderr_of(const std::string& command) {
+  FILE* pipe = popen(("(" + command + ") 2>&1").c_str(), "r");
+  REQUIRE(pipe);
+  std::string out;
+  char buffer[4096];
+  size_t n;
+  while ((n = fread(buffer, 1, sizeof buffer, pipe)) > 0) out.append(buffer, n);
+  pclose(pipe);
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("A sweep file's grid and Latin hypercube make the cases their definitions give", "[sweeps]") {
+  const fs::path dir = fresh_folder("sweep_plan");
+  write_tiny_scene(dir);
+  write(dir / "grid.json", R"({"base": {"scene": "scene.json"}, "variables": {"tissue.friction": [0.1, 0.2], "d_a_mm": {"from": -0.3, "to": 0.3, "count": 4}}})");
+  const needle::SweepPlan grid = needle::read_sweep_file((dir / "grid.json").string());
+  REQUIRE(grid.cases.size() == 8);
+  CHECK(grid.variables == std::vector<std::string>{"d_a_mm", "tissue.friction"});  // alphabetical, the last fastest
+  for (int k = 0; k < 8; ++k) {
+    const json& v = grid.cases[k].values;
+    CHECK(v["d_a_mm"].get<double>() == Approx(-0.3 + 0.2 * (k / 2)).margin(1e-15));
+    CHECK(v["tissue.friction"].get<double>() == (k % 2 == 0 ? 0.1 : 0.2));
+    CHECK(grid.cases[k].name == fmt::format("case_{:04d}", k));
+  }
+  CHECK(grid.cases.back().values["d_a_mm"].get<double>() == 0.3);  // the range's end exactly
+
+  write(dir / "lhs.json", R"({"base": {"scene": "scene.json"}, "design": {"latin_hypercube": {"samples": 7, "seed": 11}},)"
+                          R"("variables": {"d_a_mm": {"from": -0.35, "to": 0.35}, "bevel_tilt_deg": {"from": 10, "to": 14}}})");
+  const needle::SweepPlan lhs = needle::read_sweep_file((dir / "lhs.json").string());
+  REQUIRE(lhs.cases.size() == 7);
+  // One sample in each of the 7 equal strata of each variable's range.
+  for (const auto& [name, from, to] : {std::tuple<std::string, double, double>{"d_a_mm", -0.35, 0.35}, {"bevel_tilt_deg", 10.0, 14.0}}) {
+    std::set<int> strata;
+    for (const needle::SweepCase& c : lhs.cases) {
+      const double u = (c.values[name].get<double>() - from) / (to - from);
+      CHECK(u >= 0);
+      CHECK(u < 1);
+      strata.insert(static_cast<int>(u * 7));
+    }
+    CHECK(strata.size() == 7);
+  }
+  // The same seed repeats the cases; another seed gives others.
+  CHECK(needle::sweep_plan_to_json(needle::read_sweep_file((dir / "lhs.json").string())) == needle::sweep_plan_to_json(lhs));
+  write(dir / "lhs2.json", R"({"base": {"scene": "scene.json"}, "design": {"latin_hypercube": {"samples": 7, "seed": 12}},)"
+                           R"("variables": {"d_a_mm": {"from": -0.35, "to": 0.35}, "bevel_tilt_deg": {"from": 10, "to": 14}}})");
+  CHECK(needle::read_sweep_file((dir / "lhs2.json").string()).cases[0].values != lhs.cases[0].values);
+}
+
+TEST_CASE("The deflection's zero crossings lie on the straight line between the two cases around them", "[sweeps]") {
+  std::vector<needle::CaseResult> rows;
+  const std::vector<std::pair<double, double>> points = {{-0.4, -0.30}, {-0.2, -0.10}, {0.0, 0.15}, {0.2, 0.40}, {0.4, 0.0}};
+  for (size_t k = 0; k < points.size(); ++k) {
+    needle::CaseResult r;
+    r.index = static_cast<int>(k);
+    r.values = {{"d_a_mm", points[k].first}};
+    r.status = "finished";
+    r.deflection_mm = points[k].second;
+    rows.push_back(r);
+  }
+  needle::CaseResult stopped = rows[1];
+  const auto zeros = needle::deflection_zeros({"d_a_mm"}, rows);
+  REQUIRE(zeros.size() == 2);
+  CHECK(zeros[0].value == Approx(-0.2 + 0.2 * 0.10 / 0.25));  // between -0.10 and +0.15
+  CHECK(zeros[1].value == 0.4);                               // a case that went straight
+  rows[2].status = "stopped";  // a stopped case is no point of the curve: the crossing is between -0.2 and 0.2
+  const auto without = needle::deflection_zeros({"d_a_mm"}, rows);
+  REQUIRE(without.size() == 2);
+  CHECK(without[0].value == Approx(-0.2 + 0.4 * 0.10 / 0.50));
+}
+
+TEST_CASE("needle sweep gives one table on worker processes, on MPI ranks and as a batch array", "[sweeps][gmsh][lspg]") {
+  const fs::path dir = fresh_folder("sweep_workers");
+  write_tiny_sweep(dir);
+  const std::string sweep = (dir / "sweep.json").string();
+  const Result jobs = run("sweep " + sweep + " --out " + (dir / "jobs").string() + " --jobs 2", true);
+  INFO(jobs.out);
+  REQUIRE(jobs.exit_code == 0);
+  const json table = read_json(dir / "jobs" / "sweep.json");
+  CHECK(table["counts"]["cases"] == 6);
+  CHECK(table["counts"]["finished"] == 4);
+  CHECK(table["counts"]["infeasible"] == 2);
+  for (const json& c : table["cases"]) {
+    const std::string name = c["name"];
+    if (c["variables"]["d_a_mm"].get<double>() == -0.6) {
+      CHECK(c["status"] == "infeasible");
+      CHECK(c["reason"].get<std::string>().find("outside the rod") != std::string::npos);
+      continue;
+    }
+    REQUIRE(c["status"] == "finished");
+    // The record repeats its run's own summary and scene: the case ran with its variables.
+    const json summary = read_json(dir / "jobs" / "cases" / name / "run" / "summary.json");
+    const json scene = read_json(dir / "jobs" / "cases" / name / "run" / "scene.json");
+    CHECK(c["deflection_mm"].get<double>() == summary["deflection_mm"].get<double>());
+    CHECK(scene["needle"]["d_a_mm"].get<double>() == c["variables"]["d_a_mm"].get<double>());
+    CHECK(scene["tissue"]["friction"].get<double>() == c["variables"]["tissue.friction"].get<double>());
+    CHECK(scene["needle"]["model"] == "implicit");
+  }
+  std::ifstream csv(dir / "jobs" / "sweep.csv");
+  int csv_lines = 0;
+  for (std::string line; std::getline(csv, line);) ++csv_lines;
+  CHECK(csv_lines == 7);  // the header and a row a case (reasons are quoted fields of one line)
+  CHECK(fs::exists(dir / "jobs" / "deflection_vs_d_a_mm.png"));
+  const auto reference = deflections(dir / "jobs");
+  REQUIRE(reference.size() == 4);
+
+  // MPI: rank 0 hands out the cases, rank 1 runs them.
+  const std::string mpi = stderr_of("mpirun --allow-run-as-root --oversubscribe -n 2 " + std::string(NEEDLE_BINARY) + " sweep " + sweep + " --out " +
+                                    (dir / "mpi").string() + "; echo exit=$?");
+  INFO(mpi);
+  CHECK(mpi.find("exit=0") != std::string::npos);
+  CHECK(mpi.find("on 2 MPI ranks") != std::string::npos);
+  CHECK(deflections(dir / "mpi") == reference);  // bit for bit
+
+  // A batch array: one case a task (SLURM_ARRAY_TASK_ID), then --collect.
+  const Result count = run("sweep " + sweep + " --count");
+  REQUIRE(count.exit_code == 0);
+  REQUIRE(std::stoi(count.out) == 6);
+  for (int task = 0; task < 6; ++task) {
+    setenv("SLURM_ARRAY_TASK_ID", std::to_string(task).c_str(), 1);
+    const Result r = run("sweep " + sweep + " --out " + (dir / "array").string() + " --quiet", true);
+    unsetenv("SLURM_ARRAY_TASK_ID");
+    INFO(r.out);
+    REQUIRE(r.exit_code == 0);
+    CHECK(!fs::exists(dir / "array" / "sweep.csv"));  // a task writes its case, not the table
+  }
+  const Result collected = run("sweep " + sweep + " --out " + (dir / "array").string() + " --collect", true);
+  INFO(collected.out);
+  REQUIRE(collected.exit_code == 0);
+  CHECK(deflections(dir / "array") == reference);
+  const Result missing = run("sweep " + sweep + " --out " + (dir / "nothing").string() + " --collect", true);
+  CHECK(missing.exit_code == 2);
+  CHECK(!fs::exists(dir / "nothing"));
+}
+
+TEST_CASE("A sweep interrupted midway loses no finished case and repeats none when started again", "[sweeps][gmsh][lspg]") {
+  const fs::path dir = fresh_folder("sweep_resume");
+  write_tiny_scene(dir);
+  write(dir / "sweep.json", R"({"base": {"scene": "scene.json"}, "model": "fast", "variables": {"tissue.friction": {"from": 0.05, "to": 0.4, "count": 8}}})");
+  const fs::path out = dir / "out";
+  // Started in the background and sent SIGINT once its first case is done.
+  const std::string script = std::string(NEEDLE_BINARY) + " sweep " + (dir / "sweep.json").string() + " --out " + out.string() +
+                             " --quiet & pid=$!; while [ ! -f " + (out / "cases" / "case_0000" / "case.json").string() +
+                             " ]; do sleep 0.05; done; kill -INT $pid; wait $pid; echo exit=$?";
+  const std::string first = stderr_of("bash -c '" + script + "'");
+  INFO(first);
+  CHECK(first.find("exit=130") != std::string::npos);
+  CHECK(first.find("the same command goes on from there") != std::string::npos);
+  std::map<std::string, fs::file_time_type> done_before;
+  for (int k = 0; k < 8; ++k) {
+    const fs::path record = out / "cases" / fmt::format("case_{:04d}", k) / "case.json";
+    if (fs::exists(record)) done_before[record.string()] = fs::last_write_time(record);
+  }
+  REQUIRE(!done_before.empty());
+  REQUIRE(done_before.size() < 8);
+  const Result again = run("sweep " + (dir / "sweep.json").string() + " --out " + out.string(), true);
+  INFO(again.out);
+  REQUIRE(again.exit_code == 0);
+  CHECK(again.out.find(fmt::format("{} of 8 cases done before", done_before.size())) != std::string::npos);
+  for (const auto& [record, time] : done_before) CHECK(fs::last_write_time(record) == time);  // not run again
+  CHECK(read_json(out / "sweep.json")["counts"]["finished"] == 8);
+  // Another sweep into the same folder is refused, the folder untouched.
+  write(dir / "other.json", R"({"base": {"scene": "scene.json"}, "variables": {"tissue.friction": [0.3]}})");
+  const Result other = run("sweep " + (dir / "other.json").string() + " --out " + out.string(), true);
+  CHECK(other.exit_code == 2);
+  CHECK(other.out.find("holds another study") != std::string::npos);
+}
+
+TEST_CASE("Bad sweep and optimisation files get one clear error before any case runs", "[sweeps]") {
+  const fs::path dir = fresh_folder("sweep_bad");
+  write_tiny_scene(dir);
+  const std::vector<std::pair<std::string, std::string>> sweeps = {
+      {R"({"base": {"scene": "scene.json"}, "variables": {"tip_angle": [1, 2]}})", "unknown design variable 'tip_angle'"},
+      {R"({"base": {"scene": "scene.json"}, "variables": {"d_a_mm": []}})", "'d_a_mm' is an empty list"},
+      {R"({"base": {"scene": "scene.json"}, "variables": {"d_a_mm": {"from": 0.1, "to": 0.1, "count": 3}}})", "the range of 'd_a_mm' is empty"},
+      {R"({"base": {"scene": "scene.json"}, "variables": {"d_a_mm": {"from": 0, "to": 0.3, "count": 0}}})", "'count' must be a whole number"},
+      {R"({"base": {"scene": "scene.json"}, "variables": {"d_a_mm": {"from": 0, "to": 0.3}}})", "needs 'count'"},
+      {R"({"base": {"scene": "scene.json"}, "variabels": {"d_a_mm": [0]}})", "unknown key 'variabels'"},
+      {R"({"base": {"scene": "scene.json"}, "variables": {"d_a_mm": [0.7, 0.9]}})", "no case of the sweep has a tip that can be ground"},
+      {R"({"base": {"scene": "scene.json"}, "variables": {"tissue.colour": [1, 2]}})", "colour"},
+      {R"({"base": {"scene": "scene.json"}, "design": {"latin_hypercube": {"samples": 4}}, "variables": {"d_a_mm": [0, 0.1]}})",
+       "a Latin hypercube samples ranges"},
+  };
+  for (const auto& [text, message] : sweeps) {
+    write(dir / "bad.json", text);
+    const Result r = run("sweep " + (dir / "bad.json").string() + " --out " + (dir / "out").string(), true);
+    INFO(text << "\n" << r.out);
+    CHECK(r.exit_code == 2);
+    CHECK(r.out.find(message) != std::string::npos);
+    CHECK(r.out.find("bad.json") != std::string::npos);
+    CHECK(std::count(r.out.begin(), r.out.end(), '\n') == 1);
+    CHECK(!fs::exists(dir / "out"));
+  }
+  const std::vector<std::pair<std::string, std::string>> searches = {
+      {R"({"base": {"scene": "scene.json"}, "variables": {"d_a_mm": {"min": 0.3, "max": -0.3}}, "objective": {"deflection_target_mm": 0}})",
+       "contradict each other"},
+      {R"({"base": {"scene": "scene.json"}, "variables": {"d_a_mm": {"min": -0.6, "max": 0.3}}, "objective": {"deflection_target_mm": 0}})",
+       "cannot be ground"},
+      {R"({"base": {"scene": "scene.json"}, "variables": {"d_a_mm": {"min": -0.3, "max": 0.3}}, "objective": {"minimize": "abs_deflection", "groove_fill_at_least": 0.5}, "method": "bobyqa"})",
+       "needs method cobyla"},
+      {R"({"base": {"scene": "scene.json"}, "variables": {"d_a_mm": {"min": -0.3, "max": 0.3, "start": 0.5}}, "objective": {"deflection_target_mm": 0}})",
+       "outside"},
+  };
+  for (const auto& [text, message] : searches) {
+    write(dir / "bad_search.json", text);
+    const Result r = run("optimize " + (dir / "bad_search.json").string() + " --out " + (dir / "out").string(), true);
+    INFO(text << "\n" << r.out);
+    CHECK(r.exit_code == 2);
+    CHECK(r.out.find(message) != std::string::npos);
+    CHECK(!fs::exists(dir / "out"));
+  }
+}
+
+TEST_CASE("needle optimize reaches a deflection target and resumes from its evaluations; a case's tip angles make its recipe",
+          "[sweeps][gmsh][lspg]") {
+  const fs::path dir = fresh_folder("optimize");
+  write_tiny_scene(dir);
+  // The tissue's E that makes the tiny scene's tip deflect 0.02 mm (0.0197 mm at E 0.5, 0.0218 mm at 0.7).
+  write(dir / "search.json", R"({"base": {"scene": "scene.json", "d_a_mm": 0.1}, "model": "fast",)"
+                             R"("variables": {"tissue.material.E_MPa": {"min": 0.2, "max": 1.2, "start": 0.7, "step": 0.2, "tolerance": 0.005}},)"
+                             R"("objective": {"deflection_target_mm": 0.02}, "deflection_tolerance_mm": 0.0002, "max_evaluations": 10})");
+  const std::string args = "optimize " + (dir / "search.json").string() + " --out " + (dir / "out").string();
+  const Result first = run(args, true);
+  INFO(first.out);
+  REQUIRE(first.exit_code == 0);
+  const needle::CsvTable evaluations = needle::read_csv_table((dir / "out" / "evaluations.csv").string());
+  REQUIRE(evaluations.rows.size() >= 3);
+  CHECK(evaluations.rows.size() <= 10);
+  const json optimum = read_json(dir / "out" / "optimum.json");
+  CHECK(optimum["converged"] == true);
+  CHECK(std::abs(optimum["best"]["deflection_mm"].get<double>() - 0.02) <= 0.0002);
+  // The reported best is the smallest objective among the evaluations, recomputed here from their deflections; each
+  // evaluation's run took its E.
+  double best = INFINITY;
+  for (const auto& row : evaluations.rows) {
+    const double delta = row[evaluations.index("deflection_mm")];
+    CHECK(row[evaluations.index("objective")] == Approx((delta - 0.02) * (delta - 0.02)).epsilon(1e-8));
+    best = std::min(best, (delta - 0.02) * (delta - 0.02));
+  }
+  CHECK(optimum["best"]["objective"].get<double>() == Approx(best).epsilon(1e-8));
+  const std::string best_name = optimum["best"]["name"];
+  CHECK(read_json(dir / "out" / "cases" / best_name / "run" / "scene.json")["tissue"]["material"]["E_MPa"].get<double>() ==
+        optimum["best"]["variables"]["tissue.material.E_MPa"].get<double>());
+  // Started again, the search repeats NLopt's steps from the evaluations already done.
+  const Result again = run(args, true);
+  INFO(again.out);
+  REQUIRE(again.exit_code == 0);
+  CHECK(again.out.find("(done before: reused)") != std::string::npos);
+  CHECK(read_json(dir / "out" / "optimum.json")["best"] == optimum["best"]);
+  CHECK(needle::read_csv_table((dir / "out" / "evaluations.csv").string()).rows.size() == evaluations.rows.size());
+
+  // A case that varies the tip's angles runs a recipe of its own, which needle tip builds with those angles.
+  write(dir / "angles.json", R"({"base": {"scene": "scene.json", "d_a_mm": 0.1}, "model": "fast", "variables": {"top_tilt_deg": [20]}})");
+  const Result angles = run("sweep " + (dir / "angles.json").string() + " --out " + (dir / "angles").string(), true);
+  INFO(angles.out);
+  REQUIRE(angles.exit_code == 0);
+  const fs::path recipe = dir / "angles" / "cases" / "case_0000" / "recipe.json";
+  CHECK(read_json(dir / "angles" / "cases" / "case_0000" / "run" / "scene.json")["needle"]["recipe"] == recipe.string());
+  const Result tip = run("tip --recipe " + recipe.string() + " --json");
+  REQUIRE(tip.exit_code == 0);
+  const json report = json::parse(tip.out);
+  CHECK(report["d_a_mm"].get<double>() == Approx(0.1).margin(1e-6));
+  int top_facets = 0;
+  for (const json& f : report["facets"])
+    if (f["name"] == "top") {
+      ++top_facets;
+      CHECK(f["tilt_deg"].get<double>() == 20.0);
+    }
+  CHECK(top_facets == 1);
+}
