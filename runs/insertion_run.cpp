@@ -357,6 +357,8 @@ bool folder_holds_run_of(const Scene& scene, const std::string& folder_name) {
     return scene_json;
   };
   try {
+    // A run stopped by Ctrl-C holds what it had so far, not a result: it runs again.
+    if (json::parse(summary).value("status", std::string()) == "interrupted") return false;
     return without_threads(json::parse(stored)) == without_threads(json::parse(scene_to_json(scene).dump()));
   } catch (const json::exception&) {
     return false;  // an unreadable folder holds no run

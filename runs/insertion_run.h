@@ -29,7 +29,7 @@ void run_insertion(const Scene& scene, const RunOptions& options);
 // this scene (scene.json, threads aside); true if it reused one. An interrupted `paper` or `calibrate` resumes this way.
 bool run_insertion_unless_done(const Scene& scene, const RunOptions& options);
 
-// Whether folder holds a run (summary.json, finished or stopped) of exactly this scene (scene.json), whatever
+// Whether folder holds a run (summary.json, finished or stopped by the solver; not interrupted) of exactly this scene (scene.json), whatever
 // worker threads it ran on (solver.threads, which does not change a run's results).
 bool folder_holds_run_of(const Scene& scene, const std::string& folder);
 

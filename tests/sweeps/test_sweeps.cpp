@@ -215,6 +215,18 @@ TEST_CASE("A sweep interrupted midway loses no finished case and repeats none wh
   CHECK(again.out.find(fmt::format("{} of 8 cases done before", done_before.size())) != std::string::npos);
   for (const auto& [record, time] : done_before) CHECK(fs::last_write_time(record) == time);  // not run again
   CHECK(read_json(out / "sweep.json")["counts"]["finished"] == 8);
+  // A case whose run was interrupted while stepping (its folder holds what it had, marked interrupted) runs again.
+  const fs::path run3 = out / "cases" / "case_0003" / "run";
+  json summary3 = read_json(run3 / "summary.json");
+  summary3["status"] = "interrupted";
+  std::ofstream(run3 / "summary.json") << summary3.dump(2);
+  fs::remove(out / "cases" / "case_0003" / "case.json");
+  const Result rerun = run("sweep " + (dir / "sweep.json").string() + " --out " + out.string(), true);
+  INFO(rerun.out);
+  REQUIRE(rerun.exit_code == 0);
+  CHECK(rerun.out.find("7 of 8 cases done before") != std::string::npos);
+  CHECK(read_json(run3 / "summary.json")["status"] == "finished");
+  CHECK(read_json(out / "sweep.json")["counts"]["finished"] == 8);
   // Another sweep into the same folder is refused, the folder untouched.
   write(dir / "other.json", R"({"base": {"scene": "scene.json"}, "variables": {"tissue.friction": [0.3]}})");
   const Result other = run("sweep " + (dir / "other.json").string() + " --out " + out.string(), true);
