@@ -9,6 +9,7 @@
 
 #include "core/input_error.h"
 #include "geometry/mesh_io.h"
+#include "plot/heat_map.h"
 #include "plot/line_plot.h"
 #include "runs/json_file.h"
 #include "studies/paper_results.h"
@@ -112,6 +113,41 @@ void plot_against(const fs::path& dir, const std::string& variable, const std::v
   write_plot(dir / fmt::format("groove_fill_vs_{}.png", variable), fill);
 }
 
+// Maps of deflection and groove fill over a grid of two numeric variables (x the first, y the second).
+void map_over(const fs::path& dir, const std::string& x_name, const std::string& y_name, const std::vector<CaseResult>& rows) {
+  std::vector<double> xs, ys;
+  for (const CaseResult& r : rows) {
+    xs.push_back(r.values.at(x_name).get<double>());
+    ys.push_back(r.values.at(y_name).get<double>());
+  }
+  std::sort(xs.begin(), xs.end());
+  xs.erase(std::unique(xs.begin(), xs.end()), xs.end());
+  std::sort(ys.begin(), ys.end());
+  ys.erase(std::unique(ys.begin(), ys.end()), ys.end());
+  HeatMap deflection{fmt::format("Tip deflection (mm) over {} and {}", x_name, y_name), x_name, y_name};
+  deflection.x = xs;
+  deflection.y = ys;
+  deflection.values.assign(ys.size(), std::vector<double>(xs.size(), std::nan("")));
+  HeatMap fill = deflection;
+  fill.title = fmt::format("Groove fill over {} and {} (white: filled)", x_name, y_name);
+  fill.value_format = "{:.2f}";
+  fill.centre = 1.0;
+  for (const CaseResult& r : rows) {
+    if (r.status != "finished") continue;
+    const size_t i = static_cast<size_t>(std::lower_bound(xs.begin(), xs.end(), r.values.at(x_name).get<double>()) - xs.begin());
+    const size_t j = static_cast<size_t>(std::lower_bound(ys.begin(), ys.end(), r.values.at(y_name).get<double>()) - ys.begin());
+    deflection.values[j][i] = r.deflection_mm;
+    fill.values[j][i] = r.groove_fill;
+  }
+  for (const auto& [name, map] : {std::pair<std::string, const HeatMap*>{"deflection_map.png", &deflection}, {"groove_fill_map.png", &fill}}) {
+    bool any = false;
+    for (const auto& row : map->values) any = any || std::any_of(row.begin(), row.end(), [](double v) { return std::isfinite(v); });
+    if (!any) continue;
+    const RgbImage image = draw_heat_map(*map);
+    write_file_atomically((dir / name).string(), [&](const std::string& scratch) { write_png(image, scratch); });
+  }
+}
+
 }  // namespace
 
 std::vector<CaseResult> collect_case_records(const fs::path& dir, const std::vector<SweepCase>& cases) {
@@ -200,6 +236,8 @@ void write_sweep_table(const fs::path& dir, const SweepPlan& plan, const std::ve
   write_file_atomically((dir / "sweep.json").string(), [&](const std::string& scratch) { std::ofstream(scratch) << table.dump(2) << "\n"; });
   if (!plan.variables.empty() && numeric_variable(rows, plan.variables.front()) && plan.design == "grid")
     plot_against(dir, plan.variables.front(), rows, reference_file);
+  if (plan.variables.size() == 2 && numeric_variable(rows, plan.variables[0]) && numeric_variable(rows, plan.variables[1]) && plan.design == "grid")
+    map_over(dir, plan.variables[0], plan.variables[1], rows);
 }
 
 }  // namespace needle

@@ -157,6 +157,7 @@ TEST_CASE("needle sweep gives one table on worker processes, on MPI ranks and as
   for (std::string line; std::getline(csv, line);) ++csv_lines;
   CHECK(csv_lines == 7);  // the header and a row a case (reasons are quoted fields of one line)
   CHECK(fs::exists(dir / "jobs" / "deflection_vs_d_a_mm.png"));
+  CHECK(fs::exists(dir / "jobs" / "deflection_map.png"));  // two variables: a map over them
   const auto reference = deflections(dir / "jobs");
   REQUIRE(reference.size() == 4);
 
