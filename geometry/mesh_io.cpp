@@ -7,6 +7,9 @@
 #include <assimp/scene.h>
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
 #include <fmt/format.h>
 #include <random>
 
@@ -59,6 +62,15 @@ void write_file_atomically(const std::string& path, const std::function<void(con
 
 namespace {
 
+// A vertex as the files store it: rounded to a nanometre grid, then to single precision. The grid welds corners
+// the CAD left a few 1e-17 mm apart (which single precision keeps apart near 0): the sliver between them then has
+// two equal corners and is left out whole, and its neighbours share the welded corner, so the surface stays closed.
+Eigen::Vector3f written_position(const TriSurface& s, int vertex) {
+  Eigen::Vector3d p = s.V.row(vertex).transpose();
+  for (int k = 0; k < 3; ++k) p[k] = std::round(p[k] * 1e9) / 1e9;
+  return p.cast<float>();
+}
+
 // One aiMesh per group of faces; the scene owns everything it points to.
 aiMesh* make_mesh(const TriSurface& s, const std::vector<int>& faces, const std::string& name, unsigned material) {
   auto* mesh = new aiMesh;
@@ -72,7 +84,8 @@ aiMesh* make_mesh(const TriSurface& s, const std::vector<int>& faces, const std:
   mesh->mFaces = new aiFace[mesh->mNumFaces];
   for (size_t i = 0; i < faces.size(); ++i) {
     const int f = faces[i];
-    const Eigen::Vector3d a = s.V.row(s.F(f, 0)), b = s.V.row(s.F(f, 1)), c = s.V.row(s.F(f, 2));
+    const Eigen::Vector3d a = written_position(s, s.F(f, 0)).cast<double>(), b = written_position(s, s.F(f, 1)).cast<double>(),
+                          c = written_position(s, s.F(f, 2)).cast<double>();
     Eigen::Vector3d n = (b - a).cross(c - a);
     if (n.norm() > 0) n.normalize();
     aiFace& face = mesh->mFaces[i];
@@ -80,8 +93,8 @@ aiMesh* make_mesh(const TriSurface& s, const std::vector<int>& faces, const std:
     face.mIndices = new unsigned[3];
     for (int k = 0; k < 3; ++k) {
       const unsigned v = static_cast<unsigned>(3 * i + k);
-      const Eigen::Vector3d p = s.V.row(s.F(f, k));
-      mesh->mVertices[v] = aiVector3D(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
+      const Eigen::Vector3f p = written_position(s, s.F(f, k));
+      mesh->mVertices[v] = aiVector3D(p.x(), p.y(), p.z());
       mesh->mNormals[v] = aiVector3D(static_cast<float>(n.x()), static_cast<float>(n.y()), static_cast<float>(n.z()));
       face.mIndices[k] = v;
     }
@@ -94,7 +107,7 @@ aiMesh* make_mesh(const TriSurface& s, const std::vector<int>& faces, const std:
 // can be zero), which readers take for a line or a point (assimp) or refuse. Such faces are not written.
 bool degenerate_in_float(const TriSurface& s, int f) {
   Eigen::Vector3f p[3];
-  for (int k = 0; k < 3; ++k) p[k] = s.V.row(s.F(f, k)).cast<float>().transpose();
+  for (int k = 0; k < 3; ++k) p[k] = written_position(s, s.F(f, k));
   const Eigen::Vector3f e1 = p[1] - p[0], e2 = p[2] - p[0];
   const Eigen::Vector3f cross = e1.cross(e2);  // as a reader computes it, in single precision
   const Eigen::Vector3d e1d = e1.cast<double>(), e2d = e2.cast<double>();
@@ -141,6 +154,53 @@ std::unique_ptr<aiScene> make_scene(const TriSurface& s, bool mesh_per_tag) {
   return scene;
 }
 
+// What assimp writes, made readable by the other common readers (meshio, VTK): its ASCII STL puts a blank line after
+// every facet and names the solid "AssimpScene"; its PLY names the face list "vertex_index" where the format's own
+// examples, VTK and meshio read "vertex_indices"; its OBJ carries smoothed normals under indices of their own
+// ("f 1//1 2//2 3//3", fewer normals than vertices), which readers that take one normal per vertex (meshio) refuse:
+// the OBJ is written without normals (a facet's normal is its triangle's).
+void make_readable_by_others(const std::string& file, SurfaceFormat format) {
+  if (format != SurfaceFormat::stl_ascii && format != SurfaceFormat::ply && format != SurfaceFormat::obj) return;
+  std::string data;
+  {
+    std::ifstream in(file, std::ios::binary);
+    data.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  std::string fixed;
+  if (format == SurfaceFormat::obj) {
+    std::istringstream lines(data);
+    for (std::string line; std::getline(lines, line);) {
+      if (line.rfind("vn ", 0) == 0) continue;
+      if (line.rfind("f ", 0) == 0) {  // "f  1//1 2//2 3//3" -> "f 1 2 3"
+        std::istringstream corners(line.substr(2));
+        line = "f";
+        for (std::string corner; corners >> corner;) line += " " + corner.substr(0, corner.find('/'));
+      }
+      fixed += line + "\n";
+    }
+  } else if (format == SurfaceFormat::stl_ascii) {
+    fixed.reserve(data.size());
+    std::istringstream lines(data);
+    for (std::string line; std::getline(lines, line);) {
+      if (line.empty()) continue;
+      if (line == "solid AssimpScene") line = "solid needle";
+      if (line == "endsolid AssimpScene") line = "endsolid needle";
+      fixed += line + "\n";
+    }
+  } else {
+    const size_t end = data.find("end_header\n");
+    NEEDLE_REQUIRE(end != std::string::npos, fmt::format("'{}': a PLY file without its header's end", file));
+    std::string header = data.substr(0, end);
+    const std::string old_name = " vertex_index\n";
+    const size_t at = header.find(old_name);
+    if (at != std::string::npos) header.replace(at, old_name.size(), " vertex_indices\n");
+    fixed = header + data.substr(end);
+  }
+  std::ofstream out(file, std::ios::binary | std::ios::trunc);
+  out << fixed;
+  if (!out.good()) throw std::runtime_error(fmt::format("could not write '{}'", file));
+}
+
 }  // namespace
 
 std::vector<std::string> write_surface(const TriSurface& surface, const std::string& path, SurfaceFormat format) {
@@ -167,6 +227,7 @@ std::vector<std::string> write_surface(const TriSurface& surface, const std::str
   }
   std::vector<std::string> written;
   try {
+    make_readable_by_others((fs::path(scratch) / name).string(), format);
     for (const std::string& file : sidecars)
       if (fs::exists(fs::path(scratch) / file)) {
         commit_scratch_file(scratch, file, target.parent_path().string());

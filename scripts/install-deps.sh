@@ -16,6 +16,7 @@ PACKAGES=(
   libpng-dev libfreetype-dev fonts-dejavu-core
   libsuitesparse-dev libspectra-dev
   libnlopt-dev libnlopt-cxx-dev libopenmpi-dev openmpi-bin
+  python3-meshio
 )
 missing=()
 for p in "${PACKAGES[@]}"; do

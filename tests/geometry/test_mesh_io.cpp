@@ -35,9 +35,9 @@ TEST_CASE("exported files re-import closed, manifold, with the same area and vol
     const TriSurface back = read_surface(path);
     INFO(name);
     CHECK(check_topology(back).closed_manifold());
-    // Single precision may collapse a handful of sliver triangles; the rest must all come back.
+    // The slivers without area in single precision are left out (9 of LMB's 7 253); the rest must all come back.
     CHECK(back.num_faces() <= solid.surface.num_faces());
-    CHECK(back.num_faces() >= solid.surface.num_faces() - solid.surface.num_faces() / 1000);
+    CHECK(back.num_faces() >= solid.surface.num_faces() - solid.surface.num_faces() / 500);
     // Files store single precision: relative changes of order 1e-7.
     CHECK(surface_area_mm2(back) == Approx(area).epsilon(1e-5));
     CHECK(enclosed_volume_mm3(back) == Approx(volume).epsilon(1e-5));
@@ -54,6 +54,36 @@ TEST_CASE("exported files re-import closed, manifold, with the same area and vol
   }
   // No scratch folders are left behind.
   for (const auto& entry : fs::directory_iterator(dir)) CHECK(entry.path().filename().string().rfind(".needle-partial", 0) != 0);
+}
+
+TEST_CASE("exported STL, ASCII STL, OBJ and PLY are read by meshio with our triangles and area", "[geometry][io]") {
+  // Another project's reader (meshio, Debian's python3-meshio): every triangle of the file, its total area.
+  const CadSolid solid = build_cad_solid(preset_recipe("SB"), true);
+  const fs::path dir = fresh_dir("meshio");
+  for (const auto& [name, ascii] : std::vector<std::pair<std::string, bool>>{{"tip.stl", false}, {"tip_ascii.stl", true}, {"tip.obj", false}, {"tip.ply", false}}) {
+    const std::string path = (dir / name).string();
+    write_surface(solid.surface, path, surface_format_from_path(path, ascii));
+    const std::string script = "import meshio, numpy as np\n"
+                               "m = meshio.read('" + path + "')\n"
+                               "t = np.concatenate([c.data for c in m.cells if c.type == 'triangle'])\n"
+                               "p = m.points[t]\n"
+                               "print(len(t), sum(len(c.data) for c in m.cells), 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1).sum())\n";
+    std::ofstream(dir / "read.py") << script;
+    FILE* pipe = popen(("/usr/bin/python3 " + (dir / "read.py").string() + " 2>&1").c_str(), "r");
+    REQUIRE(pipe);
+    char buffer[4096] = {0};
+    const size_t n = fread(buffer, 1, sizeof buffer - 1, pipe);
+    pclose(pipe);
+    const std::string out(buffer, n);
+    INFO(name << ": " << out);
+    const TriSurface back = read_surface(path);  // what assimp reads: the faces that were written
+    long triangles = 0, cells = 0;
+    double area = 0;
+    REQUIRE(std::sscanf(out.c_str(), "%ld %ld %lf", &triangles, &cells, &area) == 3);
+    CHECK(triangles == back.num_faces());
+    CHECK(cells == triangles);  // nothing but triangles
+    CHECK(area == Approx(surface_area_mm2(solid.surface)).epsilon(1e-5));
+  }
 }
 
 TEST_CASE("exported files hold no zero-area triangle: every face read back as written is a triangle with area", "[geometry][io]") {
@@ -95,7 +125,10 @@ TEST_CASE("exported files hold no zero-area triangle: every face read back as wr
     CHECK(not_triangles == 0);
     CHECK(zero_area == 0);
     CHECK(faces <= solid.surface.num_faces() - collapsed);
-    CHECK(faces >= solid.surface.num_faces() - solid.surface.num_faces() / 1000);
+    CHECK(faces >= solid.surface.num_faces() - solid.surface.num_faces() / 500);
+    // Leaving the slivers out keeps the surface closed: corners the CAD left 1e-17 mm apart are welded first
+    // (SB's half model had 4 open edges where three such corners met).
+    CHECK(check_topology(read_surface(path)).closed_manifold());
   }
 }
 
