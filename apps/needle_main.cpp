@@ -17,6 +17,7 @@
 #include "apps/run_command.h"
 #include "apps/simulate_command.h"
 #include "apps/sweep_command.h"
+#include "apps/stress_command.h"
 #include "apps/optimize_command.h"
 #include "apps/stiffness_command.h"
 #include "apps/tip_command.h"
@@ -73,6 +74,7 @@ int main(int argc, char** argv) {
   needle::add_bench_command(app);
   needle::add_sweep_command(app);
   needle::add_optimize_command(app);
+  needle::add_stress_command(app);
   for (CLI::App* command : app.get_subcommands({})) command->parse_complete_callback([command] { refuse_non_finite_numbers(*command); });
   try {
     app.parse(argc, argv);

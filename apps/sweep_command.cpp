@@ -30,8 +30,8 @@ struct SweepOptions {
 
 void print_table_summary(const fs::path& dir, const SweepPlan& plan, const std::vector<CaseResult>& rows) {
   const SweepCounts c = count_cases(rows);
-  fmt::print("sweep: {} cases: {} finished, {} stopped, {} infeasible, {} failed, {} not run yet\n", rows.size(), c.finished, c.stopped, c.infeasible,
-             c.failed, c.pending);
+  fmt::print("sweep: {} cases: {} finished, {} stopped, {} infeasible, {} timed out, {} failed, {} not run yet\n", rows.size(), c.finished, c.stopped,
+             c.infeasible, c.timed_out, c.failed, c.pending);
   for (const DeflectionZero& z : deflection_zeros(plan.variables, rows))
     fmt::print("sweep: the deflection crosses zero at {} = {:.4g}{}\n", z.variable, z.value, z.others.empty() ? "" : " (" + describe_values(z.others) + ")");
   fmt::print("sweep: table {} and {}\n", (dir / "sweep.csv").string(), (dir / "sweep.json").string());
@@ -70,7 +70,7 @@ void run(const SweepOptions& o) {
       return;
     }
     const int threads = o.threads > 0 ? o.threads : hardware_threads();
-    const CaseResult r = run_design_case(plan.base, c.index, c.name, c.values, dir, threads, o.quiet);
+    const CaseResult r = run_design_case(plan.base, c.index, c.name, c.values, dir, threads, o.quiet, c.label);
     fmt::print("sweep: {} {} ({}){}\n", r.name, r.status, describe_values(r.values),
                r.status == "finished" ? fmt::format(": deflection {:+.4f} mm, groove fill {:.3f}", r.deflection_mm, r.groove_fill) : ": " + r.reason);
     return;

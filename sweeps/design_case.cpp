@@ -189,7 +189,7 @@ std::string tip_infeasibility(const CaseSetup& setup) {
 
 json case_result_to_json(const CaseResult& r) {
   auto number = [](double x) { return std::isfinite(x) ? json(x) : json(nullptr); };
-  return json{{"case", r.index},
+  json j{{"case", r.index},
               {"name", r.name},
               {"variables", r.values},
               {"status", r.status},
@@ -198,8 +198,13 @@ json case_result_to_json(const CaseResult& r) {
               {"groove_fill", number(r.groove_fill)},
               {"insertion_mm", number(r.insertion_mm)},
               {"runtime_s", number(r.runtime_s)},
+              {"max_energy_balance_error", number(r.max_energy_balance_error)},
+              {"max_penetration_mm", number(r.max_penetration_mm)},
+              {"particles_inside", r.particles_inside},
               {"end_forces_N", r.end_forces_N},
               {"run_folder", r.run_folder}};
+  if (!r.label.empty()) j["label"] = r.label;
+  return j;
 }
 
 CaseResult case_result_from_json(const json& j, const std::string& source) {
@@ -214,6 +219,10 @@ CaseResult case_result_from_json(const json& j, const std::string& source) {
     r.groove_fill = number_or_nan(j, "groove_fill");
     r.insertion_mm = number_or_nan(j, "insertion_mm");
     r.runtime_s = number_or_nan(j, "runtime_s");
+    r.max_energy_balance_error = number_or_nan(j, "max_energy_balance_error");
+    r.max_penetration_mm = number_or_nan(j, "max_penetration_mm");
+    r.particles_inside = j.value("particles_inside", -1L);
+    r.label = j.value("label", std::string());
     r.end_forces_N = j.at("end_forces_N").get<std::map<std::string, double>>();
     r.run_folder = j.at("run_folder").get<std::string>();
     return r;
@@ -243,10 +252,11 @@ void write_case_record(const fs::path& study_dir, const CaseResult& r) {
 }
 
 CaseResult run_design_case(const DesignBase& base, int index, const std::string& case_name, const json& values, const fs::path& study_dir,
-                           int threads, bool quiet) {
+                           int threads, bool quiet, const std::string& label) {
   CaseResult r;
   r.index = index;
   r.name = case_name;
+  r.label = label;
   r.values = values;
   const fs::path dir = case_folder(study_dir, case_name);
   fs::create_directories(dir);
@@ -287,6 +297,9 @@ CaseResult run_design_case(const DesignBase& base, int index, const std::string&
   r.deflection_mm = number_or_nan(summary, "deflection_mm");
   r.insertion_mm = number_or_nan(summary, "insertion_mm");
   r.runtime_s = number_or_nan(summary, "runtime_s");
+  r.max_energy_balance_error = number_or_nan(summary, "max_energy_balance_error");
+  r.max_penetration_mm = number_or_nan(summary, "max_penetration_mm");
+  r.particles_inside = summary.value("particles_inside", -1L);
   if (summary.contains("groove")) r.groove_fill = number_or_nan(summary.at("groove"), "groove_fill");
   const fs::path forces_file = dir / "run" / "facet_forces.csv";
   if (fs::exists(forces_file)) {
@@ -314,4 +327,10 @@ std::string describe_values(const json& values) {
   return text;
 }
 
+}  // namespace needle
+
+namespace needle {
+std::string describe_case(const std::string& label, const nlohmann::json& values) {
+  return label.empty() ? describe_values(values) : label;
+}
 }  // namespace needle

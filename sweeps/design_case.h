@@ -54,18 +54,21 @@ std::optional<GrindingRecipe> case_recipe(const CaseSetup& setup);
 // A case's tip is feasible when the grinding model can make it; the reason otherwise (empty when feasible).
 std::string tip_infeasibility(const CaseSetup& setup);
 
-// A case's outcome. Status: finished, stopped (the solver stopped, with its reason), infeasible (the tip cannot be
-// ground), failed (anything else, e.g. a worker that died), pending (not run yet).
+// A case's outcome. Status: finished, stopped (the solver stopped, with its reason: the monitor that fired),
+// infeasible (the tip cannot be ground), timed_out (stopped at the sweep's time limit for a case), failed (anything
+// else, e.g. a worker that died), pending (not run yet).
 struct CaseResult {
   int index = -1;
-  std::string name;
+  std::string name, label;
   nlohmann::json values = nlohmann::json::object();
   std::string status = "pending", reason;
   double deflection_mm = std::nan(""), groove_fill = std::nan(""), insertion_mm = std::nan(""), runtime_s = std::nan("");
+  double max_energy_balance_error = std::nan(""), max_penetration_mm = std::nan("");  // the run's worst
+  long particles_inside = -1;                                                          // at the end (-1: not run)
   std::map<std::string, double> end_forces_N;  // facet_forces.csv's last row: each facet's fx, fy, normal and friction
   std::string run_folder;                     // relative to the study folder
 
-  bool done() const { return status == "finished" || status == "stopped" || status == "infeasible"; }
+  bool done() const { return status == "finished" || status == "stopped" || status == "infeasible" || status == "timed_out"; }
 };
 nlohmann::json case_result_to_json(const CaseResult& result);
 CaseResult case_result_from_json(const nlohmann::json& json, const std::string& source);
@@ -79,11 +82,13 @@ std::optional<CaseResult> read_done_case(const std::filesystem::path& study_dir,
 // atomically. A stopped or infeasible case is a result, not an error; Interrupted (Ctrl-C) propagates with no
 // case.json written, so that the case runs again next time.
 CaseResult run_design_case(const DesignBase& base, int index, const std::string& case_name, const nlohmann::json& values,
-                           const std::filesystem::path& study_dir, int threads, bool quiet);
+                           const std::filesystem::path& study_dir, int threads, bool quiet, const std::string& label = "");
 // Writes a case's record (case.json) atomically: also used for a case whose worker died.
 void write_case_record(const std::filesystem::path& study_dir, const CaseResult& result);
 
 // "d_a_mm=-0.1 tissue.friction=0.2"
 std::string describe_values(const nlohmann::json& values);
+// The case's label where it has one, else its values.
+std::string describe_case(const std::string& label, const nlohmann::json& values);
 
 }  // namespace needle

@@ -82,7 +82,7 @@ void SweepProgress::case_done(const CaseResult& r, double wall_s) {
   const double eta_s = left * (case_seconds_ / done_here_) / workers_;
   const std::string outcome = r.status == "finished" ? fmt::format("deflection {:+.4f} mm, groove fill {:.3f}", r.deflection_mm, r.groove_fill)
                                                      : r.reason;
-  fmt::print(stderr, "sweep: {} {} in {:.0f} s ({}): {} | {} of {} done, {} failed, ETA {}\n", r.name, r.status, wall_s, describe_values(r.values),
+  fmt::print(stderr, "sweep: {} {} in {:.0f} s ({}): {} | {} of {} done, {} failed, ETA {}\n", r.name, r.status, wall_s, describe_case(r.label, r.values),
              outcome, done_, total_, failed_, left == 0 ? "0 s" : duration_words(eta_s));
 }
 
@@ -100,6 +100,7 @@ void run_sweep_with_workers(const SweepPlan& plan, const fs::path& dir, const Sw
   struct Running {
     SweepCase c;
     double start_s;
+    bool over_time = false;  // stopped at the time limit
   };
   std::map<pid_t, Running> running;
   size_t next = 0;
@@ -108,12 +109,19 @@ void run_sweep_with_workers(const SweepPlan& plan, const fs::path& dir, const Sw
     while (!watch.signal() && running.size() < static_cast<size_t>(w.jobs) && next < todo.size()) {
       const SweepCase& c = todo[next++];
       running[start_worker(c, dir, w)] = {c, now_s()};
-      progress.case_started(c.name, describe_values(c.values));
+      progress.case_started(c.name, describe_case(c.label, c.values));
     }
     if (watch.signal() && forwarded != watch.signal()) {  // a signal to this process alone (kill, a batch system) reaches the workers too
       forwarded = watch.signal();
       for (const auto& [pid, r] : running) kill(pid, forwarded);
     }
+    if (w.case_time_limit_s > 0)  // a case that hangs (or crawls) is stopped: asked first, then killed
+      for (auto& [pid, r] : running) {
+        const double over_s = now_s() - r.start_s - w.case_time_limit_s;
+        if (over_s > 0 && !r.over_time) kill(pid, SIGTERM);
+        if (over_s > 10) kill(pid, SIGKILL);
+        r.over_time = r.over_time || over_s > 0;
+      }
     int status = 0;
     const pid_t pid = waitpid(-1, &status, WNOHANG);
     if (pid <= 0) {
@@ -125,6 +133,18 @@ void run_sweep_with_workers(const SweepPlan& plan, const fs::path& dir, const Sw
     const Running r = it->second;
     running.erase(it);
     std::optional<CaseResult> result = read_done_case(dir, r.c.name, r.c.values);
+    if (!result && r.over_time) {
+      CaseResult late;
+      late.index = r.c.index;
+      late.name = r.c.name;
+      late.label = r.c.label;
+      late.values = r.c.values;
+      late.status = "timed_out";
+      late.reason = fmt::format("ran longer than the time limit for a case ({:g} s) and was stopped", w.case_time_limit_s);
+      late.runtime_s = now_s() - r.start_s;
+      write_case_record(dir, late);
+      result = late;
+    }
     if (!result) {
       const fs::path record = case_folder(dir, r.c.name) / "case.json";
       if (fs::exists(record)) result = case_result_from_json(read_json_file(record.string(), "case record"), record.string());
@@ -134,6 +154,7 @@ void run_sweep_with_workers(const SweepPlan& plan, const fs::path& dir, const Sw
       CaseResult failed;
       failed.index = r.c.index;
       failed.name = r.c.name;
+      failed.label = r.c.label;
       failed.values = r.c.values;
       failed.status = "failed";
       failed.reason = fmt::format("{} (see {})", exit_words(status), (fs::path("cases") / r.c.name / "worker.log").string());

@@ -40,13 +40,14 @@ double now_s() { return std::chrono::duration<double>(std::chrono::steady_clock:
 
 CaseResult run_case_here(const SweepPlan& plan, const SweepCase& c, const fs::path& dir, int threads) {
   try {
-    return run_design_case(plan.base, c.index, c.name, c.values, dir, threads, true);
+    return run_design_case(plan.base, c.index, c.name, c.values, dir, threads, true, c.label);
   } catch (const Interrupted&) {
     throw;
   } catch (const std::exception& e) {  // the environment (a full disk, memory): recorded, the sweep goes on
     CaseResult failed;
     failed.index = c.index;
     failed.name = c.name;
+    failed.label = c.label;
     failed.values = c.values;
     failed.status = "failed";
     failed.reason = e.what();
@@ -61,7 +62,7 @@ void dispatch(const MpiSession& mpi, const SweepPlan& plan, const fs::path& dir,
   InterruptWatch watch;
   if (mpi.size() == 1) {  // no worker rank: run them here
     for (const SweepCase& c : todo) {
-      progress.case_started(c.name, describe_values(c.values));
+      progress.case_started(c.name, describe_case(c.label, c.values));
       const double start = now_s();
       progress.case_done(run_case_here(plan, c, dir, threads), now_s() - start);
     }
@@ -99,7 +100,7 @@ void dispatch(const MpiSession& mpi, const SweepPlan& plan, const fs::path& dir,
       index = todo[next].index;
       running[worker] = index;
       started[worker] = now_s();
-      progress.case_started(fmt::format("{} on rank {}", todo[next].name, worker), describe_values(todo[next].values));
+      progress.case_started(fmt::format("{} on rank {}", todo[next].name, worker), describe_case(todo[next].label, todo[next].values));
       ++next;
     } else {
       --active;

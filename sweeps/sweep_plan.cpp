@@ -6,6 +6,7 @@
 #include <fstream>
 #include <numeric>
 #include <random>
+#include <set>
 
 #include "core/input_error.h"
 #include "geometry/mesh_io.h"
@@ -75,6 +76,40 @@ VariableSpec read_variable(const JsonDocument& doc, const std::string& name, con
 // A uniform number in [0, 1) from the generator's 53 high bits (the same on every platform, unlike std's distributions).
 double unit_uniform(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
 
+// "design": {"cases": [{"label": "...", "variable": value, ...}, ...]}: each case sets its own variables (over "set").
+SweepPlan read_explicit_cases(const JsonDocument& doc, SweepPlan plan) {
+  const json& d = doc.value.at("design");
+  NEEDLE_REQUIRE(d.size() == 1 && d.at("cases").is_array() && !d.at("cases").empty() && d.at("cases").size() <= kMaxCases,
+                 fmt::format("{}: 'cases' must be a list of 1 to {} cases, each an object of variables and an optional label", doc.where("/design"), kMaxCases));
+  NEEDLE_REQUIRE(!doc.value.contains("variables"), fmt::format("{}: explicit cases set their own variables: leave out 'variables'", doc.where("/variables")));
+  std::set<std::string> names;
+  for (size_t k = 0; k < d.at("cases").size(); ++k) {
+    const std::string pointer = fmt::format("/design/cases/{}", k);
+    const json& entry = d.at("cases").at(k);
+    NEEDLE_REQUIRE(entry.is_object(), fmt::format("{}: a case is an object of variables, e.g. {{\"label\": \"stiff\", \"tissue.material.E_MPa\": 50}}", doc.where(pointer)));
+    SweepCase c;
+    c.index = static_cast<int>(k);
+    for (const auto& item : entry.items()) {
+      const std::string where = doc.where(pointer + "/" + json_pointer_token(item.key()));
+      if (item.key() == "label") {
+        NEEDLE_REQUIRE(item.value().is_string(), fmt::format("{}: 'label' must be a string", where));
+        c.label = item.value().get<std::string>();
+        continue;
+      }
+      check_variable_name(item.key(), where);
+      NEEDLE_REQUIRE(item.value().is_number() || item.value().is_boolean() || item.value().is_array() || (item.value().is_string() && !is_tip_variable(item.key())),
+                     fmt::format("{}: '{}' must be a number (got {})", where, item.key(), item.value().dump()));
+      c.values[item.key()] = item.value();
+      names.insert(item.key());
+    }
+    c.name = fmt::format("case_{:04d}", c.index);
+    plan.cases.push_back(c);
+  }
+  plan.variables.assign(names.begin(), names.end());
+  plan.design = "cases";
+  return plan;
+}
+
 }  // namespace
 
 SweepPlan read_sweep_file(const std::string& path) {
@@ -89,6 +124,7 @@ SweepPlan read_sweep_file(const std::string& path) {
                    fmt::format("{}: unknown key '{}' (a sweep file has base, model, set, variables and design; docs/sweeps.md)",
                                doc.where("/" + json_pointer_token(item.key())), item.key()));
   }
+  if (v.contains("design") && v.at("design").is_object() && v.at("design").contains("cases")) return read_explicit_cases(doc, std::move(plan));
   NEEDLE_REQUIRE(v.contains("variables") && v.at("variables").is_object() && !v.at("variables").empty(),
                  fmt::format("{}: give 'variables': an object of design variables, e.g. {{\"d_a_mm\": {{\"from\": -0.4, \"to\": 0.5, \"count\": 10}}}}",
                              doc.where("/variables")));
@@ -165,7 +201,10 @@ SweepPlan read_sweep_file(const std::string& path) {
 
 json sweep_plan_to_json(const SweepPlan& plan) {
   json cases = json::array();
-  for (const SweepCase& c : plan.cases) cases.push_back({{"case", c.index}, {"name", c.name}, {"variables", c.values}});
+  for (const SweepCase& c : plan.cases) {
+    cases.push_back({{"case", c.index}, {"name", c.name}, {"variables", c.values}});
+    if (!c.label.empty()) cases.back()["label"] = c.label;
+  }
   json j = design_base_to_json(plan.base);
   j["design"] = plan.design;
   j["variables"] = plan.variables;

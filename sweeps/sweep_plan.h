@@ -1,6 +1,7 @@
 #pragma once
 // A sweep file (docs/sweeps.md) and the cases it makes: the base scene, the design variables as lists or ranges
-// (a full grid over them) or ranges sampled by a seeded Latin hypercube. Everything a bad file can get wrong is
+// (a full grid over them), ranges sampled by a seeded Latin hypercube, or a list of explicit cases (each its own
+// variables and a label: the hard-case suite). Everything a bad file can get wrong is
 // found here, before any case runs: unknown keys and variables, empty ranges, values the scene refuses, a sweep
 // whose every tip is infeasible.
 #include <filesystem>
@@ -15,15 +16,16 @@ namespace needle {
 
 struct SweepCase {
   int index = 0;
-  std::string name;  // case_0007
-  nlohmann::json values = nlohmann::json::object();  // variable -> value
+  std::string name;   // case_0007
+  std::string label;  // what the case is for (explicit cases may say), or empty
+  nlohmann::json values = nlohmann::json::object();  // variable -> value (an explicit case sets only its own)
 };
 
 struct SweepPlan {
   std::string source;                  // the sweep file
   DesignBase base;
   std::vector<std::string> variables;  // the table's variable columns (alphabetical)
-  std::string design;                  // "grid" or "latin hypercube, N samples, seed S"
+  std::string design;                  // "grid", "latin hypercube, N samples, seed S" or "cases"
   std::vector<SweepCase> cases;
 };
 

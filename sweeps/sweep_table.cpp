@@ -162,6 +162,7 @@ std::vector<CaseResult> collect_case_records(const fs::path& dir, const std::vec
     }
     r.index = c.index;
     r.name = c.name;
+    r.label = c.label;
     rows.push_back(r);
   }
   return rows;
@@ -191,6 +192,7 @@ SweepCounts count_cases(const std::vector<CaseResult>& rows) {
   SweepCounts c;
   for (const CaseResult& r : rows) {
     if (r.status == "finished") ++c.finished;
+    else if (r.status == "timed_out") ++c.timed_out;
     else if (r.status == "stopped") ++c.stopped;
     else if (r.status == "infeasible") ++c.infeasible;
     else if (r.status == "failed") ++c.failed;
@@ -207,14 +209,15 @@ void write_sweep_table(const fs::path& dir, const SweepPlan& plan, const std::ve
     std::ofstream out(scratch);
     out << "case,name";
     for (const std::string& v : plan.variables) out << "," << csv_field(v);
-    out << ",status,deflection_mm,groove_fill,insertion_mm,runtime_s";
+    out << ",label,status,deflection_mm,groove_fill,insertion_mm,runtime_s,max_energy_balance_error,max_penetration_mm,particles_inside";
     for (const std::string& f : force_columns) out << ",end_" << f;
     out << ",run_folder,reason\n";
     for (const CaseResult& r : rows) {
       out << r.index << "," << r.name;
       for (const std::string& v : plan.variables) out << "," << (r.values.contains(v) ? value_field(r.values.at(v)) : "");
-      out << "," << r.status << "," << number_field(r.deflection_mm) << "," << number_field(r.groove_fill) << "," << number_field(r.insertion_mm)
-          << "," << number_field(r.runtime_s);
+      out << "," << csv_field(r.label) << "," << r.status << "," << number_field(r.deflection_mm) << "," << number_field(r.groove_fill) << ","
+          << number_field(r.insertion_mm) << "," << number_field(r.runtime_s) << "," << number_field(r.max_energy_balance_error) << ","
+          << number_field(r.max_penetration_mm) << "," << (r.particles_inside >= 0 ? std::to_string(r.particles_inside) : "");
       for (const std::string& f : force_columns) out << "," << (r.end_forces_N.count(f) ? number_field(r.end_forces_N.at(f)) : "");
       out << "," << csv_field(r.run_folder) << "," << csv_field(r.reason) << "\n";
     }
@@ -230,7 +233,7 @@ void write_sweep_table(const fs::path& dir, const SweepPlan& plan, const std::ve
                    {"variables", plan.variables},
                    {"counts",
                     {{"cases", rows.size()}, {"finished", counts.finished}, {"stopped", counts.stopped}, {"infeasible", counts.infeasible},
-                     {"failed", counts.failed}, {"pending", counts.pending}}},
+                     {"timed_out", counts.timed_out}, {"failed", counts.failed}, {"pending", counts.pending}}},
                    {"deflection_zero_crossings", zeros},
                    {"cases", cases}};
   write_file_atomically((dir / "sweep.json").string(), [&](const std::string& scratch) { std::ofstream(scratch) << table.dump(2) << "\n"; });

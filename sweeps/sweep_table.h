@@ -26,7 +26,7 @@ struct DeflectionZero {
 std::vector<DeflectionZero> deflection_zeros(const std::vector<std::string>& variables, const std::vector<CaseResult>& rows);
 
 struct SweepCounts {
-  int finished = 0, stopped = 0, infeasible = 0, failed = 0, pending = 0;
+  int finished = 0, stopped = 0, infeasible = 0, timed_out = 0, failed = 0, pending = 0;
 };
 SweepCounts count_cases(const std::vector<CaseResult>& rows);
 

@@ -337,3 +337,64 @@ TEST_CASE("needle optimize reaches a deflection target and resumes from its eval
     }
   CHECK(top_facets == 1);
 }
+
+TEST_CASE("Explicit cases set only their own variables and keep their labels", "[sweeps]") {
+  const fs::path dir = fresh_folder("sweep_cases");
+  write_tiny_scene(dir);
+  write(dir / "cases.json", R"({"base": {"scene": "scene.json"}, "set": {"tissue.friction": 0.3}, "design": {"cases": [)"
+                            R"({"label": "stiff", "tissue.material.E_MPa": 5}, {"label": "sharp", "d_a_mm": -0.4}, {"tissue.friction": 0.1}]}})");
+  const needle::SweepPlan plan = needle::read_sweep_file((dir / "cases.json").string());
+  REQUIRE(plan.cases.size() == 3);
+  CHECK(plan.design == "cases");
+  CHECK(plan.variables == std::vector<std::string>{"d_a_mm", "tissue.friction", "tissue.material.E_MPa"});
+  CHECK(plan.cases[0].label == "stiff");
+  CHECK(plan.cases[0].values == json{{"tissue.material.E_MPa", 5}});
+  // Each case's scene: its own variable over the base and the fixed keys, a case's key over a fixed one.
+  const needle::Scene stiff = needle::case_setup(plan.base, plan.cases[0].values).scene;
+  const needle::Scene sharp = needle::case_setup(plan.base, plan.cases[1].values).scene;
+  const needle::Scene smooth = needle::case_setup(plan.base, plan.cases[2].values).scene;
+  CHECK(stiff.tissue.material.E_MPa == 5);
+  CHECK(stiff.tissue.friction == 0.3);
+  CHECK(sharp.needle.d_a_mm == -0.4);
+  CHECK(sharp.tissue.material.E_MPa == smooth.tissue.material.E_MPa);
+  CHECK(smooth.tissue.friction == 0.1);
+  write(dir / "bad.json", R"({"base": {"scene": "scene.json"}, "design": {"cases": [{"label": 3}]}})");
+  CHECK_THROWS_WITH(needle::read_sweep_file((dir / "bad.json").string()), Catch::Contains("'label' must be a string"));
+}
+
+TEST_CASE("needle stress runs the short hard-case suite: each case finished with finite numbers or stopped by a monitor",
+          "[sweeps][gmsh][lspg]") {
+  const fs::path dir = fresh_folder("stress");
+  const Result r = run("stress --short --out " + (dir / "out").string(), true);
+  INFO(r.out);
+  REQUIRE(r.exit_code == 0);
+  const json table = read_json(dir / "out" / "sweep.json");
+  REQUIRE(table["cases"].size() == 6);
+  for (const json& c : table["cases"]) {
+    INFO(c.dump());
+    CHECK(!c["label"].get<std::string>().empty());
+    const bool finished = c["status"] == "finished", stopped = c["status"] == "stopped";
+    CHECK((finished || stopped));
+    if (finished) {
+      CHECK(std::isfinite(c["deflection_mm"].get<double>()));
+      CHECK(c["max_energy_balance_error"].get<double>() < 0.05);  // the run's own stop limit
+    } else {
+      CHECK(!c["reason"].get<std::string>().empty());
+    }
+  }
+  std::ifstream report(dir / "out" / "stress.md");
+  const std::string text((std::istreambuf_iterator<char>(report)), std::istreambuf_iterator<char>());
+  CHECK(text.find("6 of 6 cases pass; 0 finding(s).") != std::string::npos);
+  CHECK(text.find("| very soft tissue (E 0.001 MPa) |") != std::string::npos);
+
+  // A case that outlives the time limit is stopped, recorded as timed out, and is a finding (exit 1).
+  write(dir / "slow.json", "{\"base\": {\"scene\": \"" + (fs::path(NEEDLE_SOURCE_DIR) / "data" / "stress" / "stress_scene.json").string() +
+                               "\"}, \"model\": \"fast\", \"design\": {\"cases\": [{\"label\": \"slow\", \"motion.travel_mm\": 20}]}}");
+  const Result slow = run("stress --suite " + (dir / "slow.json").string() + " --case-time-limit-s 1 --out " + (dir / "slow").string(), true);
+  INFO(slow.out);
+  CHECK(slow.exit_code == 1);
+  CHECK(slow.out.find("1 finding(s)") != std::string::npos);
+  const json slow_table = read_json(dir / "slow" / "sweep.json");
+  CHECK(slow_table["cases"][0]["status"] == "timed_out");
+  CHECK(slow_table["cases"][0]["reason"].get<std::string>().find("time limit") != std::string::npos);
+}
