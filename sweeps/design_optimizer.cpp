@@ -1,6 +1,7 @@
 #include "sweeps/design_optimizer.h"
 
 #include <algorithm>
+#include <boost/math/tools/toms748_solve.hpp>
 #include <chrono>
 #include <exception>
 #include <fmt/format.h>
@@ -120,8 +121,14 @@ OptimizationProblem read_optimization_file(const std::string& path) {
   NEEDLE_REQUIRE(std::isnan(p.groove_fill_at_least) || (p.groove_fill_at_least >= 0 && p.groove_fill_at_least <= 1),
                  fmt::format("{}: groove_fill_at_least is a share of the groove's depth, from 0 to 1", doc.where("/objective/groove_fill_at_least")));
   const bool constrained = std::isfinite(p.groove_fill_at_least);
-  p.method = v.contains("method") && v.at("method").is_string() ? v.at("method").get<std::string>() : (constrained ? "cobyla" : "bobyqa");
-  NEEDLE_REQUIRE(methods().count(p.method), fmt::format("{}: method must be bobyqa, cobyla, neldermead or sbplx", doc.where("/method")));
+  // One variable toward a deflection target is a root: bracketed (TOMS 748) it converges however rough delta(d_a) is.
+  const bool root = p.deflection_target && p.variables.size() == 1 && !constrained;
+  p.method = v.contains("method") && v.at("method").is_string() ? v.at("method").get<std::string>() : (constrained ? "cobyla" : root ? "toms748" : "bobyqa");
+  NEEDLE_REQUIRE(methods().count(p.method) || p.method == "toms748",
+                 fmt::format("{}: method must be toms748, bobyqa, cobyla, neldermead or sbplx", doc.where("/method")));
+  NEEDLE_REQUIRE(p.method != "toms748" || root,
+                 fmt::format("{}: toms748 finds where one variable makes the deflection its target: one variable, deflection_target_mm, no constraint",
+                             doc.where("/method")));
   NEEDLE_REQUIRE(!constrained || p.method == "cobyla",
                  fmt::format("{}: {} takes no constraint: groove_fill_at_least needs method cobyla", doc.where("/method"), p.method));
   p.max_evaluations = static_cast<int>(number_at(doc, v, "max_evaluations", "", 20));
@@ -202,8 +209,45 @@ OptimizationOutcome optimize_design(const OptimizationProblem& p, const fs::path
   };
   Callback objective = [&](const std::vector<double>& x) { return objective_of(finished_case(x)); };
   Callback constraint = [&](const std::vector<double>& x) { return p.groove_fill_at_least - finished_case(x).groove_fill; };  // <= 0: fills enough
+  if (p.method == "toms748") {
+    // Boost.Math's TOMS 748: the target's sign change between the bounds is kept and shrunk (interpolation steps,
+    // bisection where they stall) until the bracket is narrower than twice the variable's tolerance.
+    const OptimizedVariable& x = p.variables.front();
+    struct CloseEnough {};
+    auto f = [&](double at) {
+      const CaseResult& r = evaluate({at});
+      if (r.status != "finished") {
+        stop_reason = fmt::format("{} {}: {}", r.name, r.status, r.reason);
+        throw nlopt::forced_stop();
+      }
+      const double miss = r.deflection_mm - p.target_deflection_mm;
+      if (std::isfinite(p.deflection_tolerance_mm) && std::abs(miss) <= p.deflection_tolerance_mm) throw CloseEnough{};
+      return miss;
+    };
+    try {
+      const double f_min = f(x.min), f_max = f(x.max);
+      if ((f_min < 0) == (f_max < 0)) {
+        outcome.stop_reason = fmt::format("the deflection does not reach the target between the bounds ({:+.4f} mm at {:g}, {:+.4f} mm at {:g})",
+                                          f_min + p.target_deflection_mm, x.min, f_max + p.target_deflection_mm, x.max);
+      } else {
+        boost::uintmax_t iterations = static_cast<boost::uintmax_t>(std::max(1, p.max_evaluations - 2));
+        const auto bracket = boost::math::tools::toms748_solve(f, x.min, x.max, f_min, f_max,
+                                                                [&](double a, double b) { return std::abs(b - a) <= 2 * x.tolerance; }, iterations);
+        const bool narrow = std::abs(bracket.second - bracket.first) <= 2 * x.tolerance;
+        outcome.converged = narrow;
+        outcome.stop_reason = narrow ? fmt::format("the target lies between {} = {:.5g} and {:.5g}", x.name, bracket.first, bracket.second)
+                                     : fmt::format("max_evaluations reached with the target between {:.5g} and {:.5g}", bracket.first, bracket.second);
+        outcome.bracket = {bracket.first, bracket.second};
+      }
+    } catch (const CloseEnough&) {
+      outcome.converged = true;
+      outcome.stop_reason = "the deflection is within its tolerance of the target";
+    } catch (const nlopt::forced_stop&) {
+      outcome.stop_reason = "an evaluation did not finish: " + stop_reason;
+    }
+  }
   auto trampoline = [](const std::vector<double>& x, std::vector<double>&, void* data) { return (*static_cast<Callback*>(data))(x); };
-  nlopt::opt opt(methods().at(p.method), static_cast<unsigned>(n));
+  nlopt::opt opt(methods().count(p.method) ? methods().at(p.method) : nlopt::LN_BOBYQA, static_cast<unsigned>(n));
   std::vector<double> lower(n), upper(n), step(n), tolerance(n), x(n);
   for (size_t k = 0; k < n; ++k) {
     lower[k] = p.variables[k].min;
@@ -222,12 +266,13 @@ OptimizationOutcome optimize_design(const OptimizationProblem& p, const fs::path
   if (constrained) opt.add_inequality_constraint(trampoline, &constraint, 1e-3);
   double value = 0;
   try {
+    if (p.method == "toms748") throw nlopt::forced_stop();  // done above
     const nlopt::result result = opt.optimize(x, value);
     outcome.stop_reason = result_words(result);
     outcome.converged = result == nlopt::STOPVAL_REACHED || result == nlopt::XTOL_REACHED || result == nlopt::FTOL_REACHED || result == nlopt::SUCCESS;
   } catch (const nlopt::forced_stop&) {
     if (failure) std::rethrow_exception(failure);
-    outcome.stop_reason = "an evaluation did not finish: " + stop_reason;
+    if (p.method != "toms748") outcome.stop_reason = "an evaluation did not finish: " + stop_reason;
   } catch (const nlopt::roundoff_limited&) {
     outcome.stop_reason = "NLopt stopped at the limit of the objective's rounding";
   }
@@ -263,6 +308,7 @@ OptimizationOutcome optimize_design(const OptimizationProblem& p, const fs::path
                {"evaluations", outcome.evaluations.size()},
                {"stop_reason", outcome.stop_reason},
                {"converged", outcome.converged}};
+  if (outcome.bracket.size() == 2) optimum["bracket"] = {{"variable", p.variables.front().name}, {"from", outcome.bracket[0]}, {"to", outcome.bracket[1]}};
   if (outcome.best >= 0) {
     const CaseResult& best = outcome.evaluations[static_cast<size_t>(outcome.best)];
     optimum["best"] = case_result_to_json(best);

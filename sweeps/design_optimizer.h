@@ -2,7 +2,9 @@
 // `needle optimize`: a derivative-free search (NLopt) over design variables within bounds, each evaluation one
 // design case (design_case.h) in DIR/cases/eval_NNNN, so that a search started again repeats NLopt's deterministic
 // sequence from the evaluations already done instead of running them again. Objectives (docs/sweeps.md):
-//   deflection_target_mm t          minimise (delta - t)^2: the tip that deflects t (0: the needle that goes straight);
+//   deflection_target_mm t          the tip that deflects t (0: the needle that goes straight): over one variable a root,
+//                                   bracketed by Boost.Math's TOMS 748 (method toms748, the default there); over several,
+//                                   NLopt minimises (delta - t)^2;
 //   minimize abs_deflection         minimise |delta|, optionally with groove fill >= a threshold (a COBYLA constraint).
 // Writes evaluations.csv (every evaluation), optimum.json and best_recipe.json (the best tip, for `needle tip --recipe`).
 #include <cmath>
@@ -27,7 +29,7 @@ struct OptimizationProblem {
   double target_deflection_mm = 0;
   double groove_fill_at_least = std::nan("");  // a constraint (NaN: none)
   double deflection_tolerance_mm = std::nan("");  // stop once |delta - target| is below (NaN: on the variables' tolerances alone)
-  std::string method;                  // bobyqa, cobyla, neldermead, sbplx
+  std::string method;                  // toms748 (one variable, a deflection target), bobyqa, cobyla, neldermead, sbplx
   int max_evaluations = 20;
 };
 
@@ -40,6 +42,7 @@ struct OptimizationOutcome {
   int best = -1;                 // index into evaluations
   std::string stop_reason;       // NLopt's, in words
   bool converged = false;
+  std::vector<double> bracket;   // toms748: the last bracket of the target (from, to)
 };
 
 // Runs the search into dir (created, or an earlier search of the same problem resumed). Progress on stderr unless quiet.

@@ -288,6 +288,19 @@ TEST_CASE("needle optimize reaches a deflection target and resumes from its eval
   write(dir / "search.json", R"({"base": {"scene": "scene.json", "d_a_mm": 0.1}, "model": "fast",)"
                              R"("variables": {"tissue.material.E_MPa": {"min": 0.2, "max": 1.2, "start": 0.7, "step": 0.2, "tolerance": 0.005}},)"
                              R"("objective": {"deflection_target_mm": 0.02}, "deflection_tolerance_mm": 0.0002, "max_evaluations": 10})");
+  // The same search with NLopt's BOBYQA on (delta - t)^2 instead of the bracketing root finder (the default for one
+  // variable and a target).
+  std::string bobyqa_text = R"({"base": {"scene": "scene.json", "d_a_mm": 0.1}, "model": "fast", "method": "bobyqa",)"
+                            R"("variables": {"tissue.material.E_MPa": {"min": 0.2, "max": 1.2, "start": 0.7, "step": 0.2, "tolerance": 0.005}},)"
+                            R"("objective": {"deflection_target_mm": 0.02}, "deflection_tolerance_mm": 0.0002, "max_evaluations": 10})";
+  write(dir / "bobyqa.json", bobyqa_text);
+  const Result bobyqa = run("optimize " + (dir / "bobyqa.json").string() + " --out " + (dir / "bobyqa").string(), true);
+  INFO(bobyqa.out);
+  REQUIRE(bobyqa.exit_code == 0);
+  const json bobyqa_optimum = read_json(dir / "bobyqa" / "optimum.json");
+  CHECK(bobyqa_optimum["method"] == "bobyqa");
+  CHECK(std::abs(bobyqa_optimum["best"]["deflection_mm"].get<double>() - 0.02) <= 0.0002);
+
   const std::string args = "optimize " + (dir / "search.json").string() + " --out " + (dir / "out").string();
   const Result first = run(args, true);
   INFO(first.out);
@@ -296,6 +309,7 @@ TEST_CASE("needle optimize reaches a deflection target and resumes from its eval
   REQUIRE(evaluations.rows.size() >= 3);
   CHECK(evaluations.rows.size() <= 10);
   const json optimum = read_json(dir / "out" / "optimum.json");
+  CHECK(optimum["method"] == "toms748");
   CHECK(optimum["converged"] == true);
   CHECK(std::abs(optimum["best"]["deflection_mm"].get<double>() - 0.02) <= 0.0002);
   // The reported best is the smallest objective among the evaluations, recomputed here from their deflections; each
