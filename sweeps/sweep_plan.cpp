@@ -69,7 +69,9 @@ VariableSpec read_variable(const JsonDocument& doc, const std::string& name, con
   const int count = count_of(doc, spec, pointer);
   NEEDLE_REQUIRE(count > 1 || v.from == v.to, fmt::format("{}: 'count' 1 gives one value: make 'from' and 'to' equal, or count at least 2", doc.where(pointer)));
   NEEDLE_REQUIRE(count == 1 || v.from != v.to, fmt::format("{}: the range of '{}' is empty (from = to = {:g}) but count is {}", doc.where(pointer), name, v.from, count));
-  for (int k = 0; k < count; ++k) v.values.push_back(k == count - 1 ? v.to : v.from + (v.to - v.from) * k / (count - 1));
+  // Each point to 15 significant digits, so that -0.4 + 0.1 is written -0.3 (not -0.30000000000000004).
+  for (int k = 0; k < count; ++k)
+    v.values.push_back(k == count - 1 ? v.to : std::stod(fmt::format("{:.15g}", v.from + (v.to - v.from) * k / (count - 1))));
   return v;
 }
 

@@ -80,6 +80,7 @@ TEST_CASE("A sweep file's grid and Latin hypercube make the cases their definiti
     CHECK(grid.cases[k].name == fmt::format("case_{:04d}", k));
   }
   CHECK(grid.cases.back().values["d_a_mm"].get<double>() == 0.3);  // the range's end exactly
+  CHECK(grid.cases[2].values["d_a_mm"].get<double>() == -0.1);     // the decimal, not -0.3 + 0.2 in binary
 
   write(dir / "lhs.json", R"({"base": {"scene": "scene.json"}, "design": {"latin_hypercube": {"samples": 7, "seed": 11}},)"
                           R"("variables": {"d_a_mm": {"from": -0.35, "to": 0.35}, "bevel_tilt_deg": {"from": 10, "to": 14}}})");
