@@ -57,6 +57,15 @@ std::optional<GrindingRecipe> scene_recipe(const NeedleScene& n) {
 
 }  // namespace
 
+void refuse_unknown_keys(const JsonDocument& doc, const json& object, const std::string& pointer, const std::vector<std::string>& known) {
+  for (const auto& item : object.items()) {
+    if (std::find(known.begin(), known.end(), item.key()) != known.end()) continue;
+    std::string list;
+    for (const std::string& k : known) list += (list.empty() ? "" : ", ") + k;
+    throw InputError(fmt::format("{}: unknown key '{}' (known: {})", doc.where(pointer + "/" + json_pointer_token(item.key())), item.key(), list));
+  }
+}
+
 DesignBase read_design_base(const JsonDocument& doc) {
   DesignBase b;
   const json& v = doc.value;
@@ -64,12 +73,7 @@ DesignBase read_design_base(const JsonDocument& doc) {
   if (v.contains("base")) {
     const json& base = v.at("base");
     NEEDLE_REQUIRE(base.is_object(), fmt::format("{}: 'base' must be an object: scene, preset, d_a_mm, recipe, calibration", doc.where("/base")));
-    for (const auto& item : base.items()) {
-      static const std::vector<std::string> known = {"scene", "preset", "d_a_mm", "recipe", "calibration"};
-      NEEDLE_REQUIRE(std::find(known.begin(), known.end(), item.key()) != known.end(),
-                     fmt::format("{}: unknown key 'base.{}' (known: scene, preset, d_a_mm, recipe, calibration)",
-                                 doc.where("/base/" + json_pointer_token(item.key())), item.key()));
-    }
+    refuse_unknown_keys(doc, base, "/base", {"scene", "preset", "d_a_mm", "recipe", "calibration"});
     b.scene_file = path_beside(doc.source, text_of(doc, base, "scene", "/base"));
     b.preset = text_of(doc, base, "preset", "/base");
     b.recipe_file = path_beside(doc.source, text_of(doc, base, "recipe", "/base"));
@@ -187,6 +191,18 @@ std::string tip_infeasibility(const CaseSetup& setup) {
   return "";
 }
 
+CaseResult case_record(int index, const std::string& name, const std::string& label, const json& values, const std::string& status,
+                       const std::string& reason) {
+  CaseResult r;
+  r.index = index;
+  r.name = name;
+  r.label = label;
+  r.values = values;
+  r.status = status;
+  r.reason = reason;
+  return r;
+}
+
 json case_result_to_json(const CaseResult& r) {
   auto number = [](double x) { return std::isfinite(x) ? json(x) : json(nullptr); };
   json j{{"case", r.index},
@@ -253,11 +269,7 @@ void write_case_record(const fs::path& study_dir, const CaseResult& r) {
 
 CaseResult run_design_case(const DesignBase& base, int index, const std::string& case_name, const json& values, const fs::path& study_dir,
                            int threads, bool quiet, const std::string& label) {
-  CaseResult r;
-  r.index = index;
-  r.name = case_name;
-  r.label = label;
-  r.values = values;
+  CaseResult r = case_record(index, case_name, label, values, "pending", "");
   const fs::path dir = case_folder(study_dir, case_name);
   fs::create_directories(dir);
   const auto start = std::chrono::steady_clock::now();

@@ -28,6 +28,10 @@ struct DesignBase {
   nlohmann::json settings = nlohmann::json::object();  // "set": dotted scene key -> value
 };
 
+// InputError at the key's line for a key of the object (at JSON pointer `pointer`) that is not one of `known`:
+// "<file>:<line>: unknown key '<key>' (known: a, b, c)".
+void refuse_unknown_keys(const JsonDocument& doc, const nlohmann::json& object, const std::string& pointer, const std::vector<std::string>& known);
+
 // Reads the study file's "base", "model" and "set" entries (the keys it does not know are the caller's); paths are
 // taken relative to the study file's folder. InputError naming the file and line.
 DesignBase read_design_base(const JsonDocument& doc);
@@ -71,6 +75,9 @@ struct CaseResult {
   bool done() const { return status == "finished" || status == "stopped" || status == "infeasible" || status == "timed_out"; }
 };
 nlohmann::json case_result_to_json(const CaseResult& result);
+// The record of a case that ended without a run's result (timed out, failed, infeasible), with its reason.
+CaseResult case_record(int index, const std::string& name, const std::string& label, const nlohmann::json& values, const std::string& status,
+                       const std::string& reason);
 CaseResult case_result_from_json(const nlohmann::json& json, const std::string& source);
 
 // The case's folder inside a study folder: DIR/cases/<name>.

@@ -72,13 +72,7 @@ OptimizationProblem read_optimization_file(const std::string& path) {
   p.source = path;
   p.base = read_design_base(doc);
   const json& v = doc.value;
-  for (const auto& item : v.items()) {
-    static const std::vector<std::string> known = {"base", "model", "set", "variables", "objective", "method", "max_evaluations", "deflection_tolerance_mm"};
-    NEEDLE_REQUIRE(std::find(known.begin(), known.end(), item.key()) != known.end(),
-                   fmt::format("{}: unknown key '{}' (an optimisation file has base, model, set, variables, objective, method, max_evaluations, "
-                               "deflection_tolerance_mm; docs/sweeps.md)",
-                               doc.where("/" + json_pointer_token(item.key())), item.key()));
-  }
+  refuse_unknown_keys(doc, v, "", {"base", "model", "set", "variables", "objective", "method", "max_evaluations", "deflection_tolerance_mm"});
   NEEDLE_REQUIRE(v.contains("variables") && v.at("variables").is_object() && !v.at("variables").empty() && v.at("variables").size() <= 10,
                  fmt::format("{}: give 'variables': one to ten design variables, each {{\"min\": a, \"max\": b}}", doc.where("/variables")));
   for (const auto& item : v.at("variables").items()) {
@@ -87,9 +81,7 @@ OptimizationProblem read_optimization_file(const std::string& path) {
     NEEDLE_REQUIRE(!p.base.settings.contains(item.key()), fmt::format("{}: '{}' is both a design variable and a fixed key of 'set'", doc.where(pointer), item.key()));
     const json& spec = item.value();
     NEEDLE_REQUIRE(spec.is_object(), fmt::format("{}: give '{}' as {{\"min\": a, \"max\": b}} (start, step and tolerance optional)", doc.where(pointer), item.key()));
-    for (const auto& key : spec.items())
-      NEEDLE_REQUIRE(key.key() == "min" || key.key() == "max" || key.key() == "start" || key.key() == "step" || key.key() == "tolerance",
-                     fmt::format("{}: unknown key '{}' (known: min, max, start, step, tolerance)", doc.where(pointer + "/" + json_pointer_token(key.key())), key.key()));
+    refuse_unknown_keys(doc, spec, pointer, {"min", "max", "start", "step", "tolerance"});
     OptimizedVariable x;
     x.name = item.key();
     NEEDLE_REQUIRE(spec.contains("min") && spec.contains("max"), fmt::format("{}: '{}' needs 'min' and 'max'", doc.where(pointer), x.name));
@@ -107,10 +99,7 @@ OptimizationProblem read_optimization_file(const std::string& path) {
                  fmt::format("{}: give 'objective': {{\"deflection_target_mm\": 0}} or {{\"minimize\": \"abs_deflection\", \"groove_fill_at_least\": 0.8}}",
                              doc.where("/objective")));
   const json& objective = v.at("objective");
-  for (const auto& key : objective.items())
-    NEEDLE_REQUIRE(key.key() == "deflection_target_mm" || key.key() == "minimize" || key.key() == "groove_fill_at_least",
-                   fmt::format("{}: unknown key '{}' (known: deflection_target_mm, minimize, groove_fill_at_least)",
-                               doc.where("/objective/" + json_pointer_token(key.key())), key.key()));
+  refuse_unknown_keys(doc, objective, "/objective", {"deflection_target_mm", "minimize", "groove_fill_at_least"});
   NEEDLE_REQUIRE(objective.contains("deflection_target_mm") != objective.contains("minimize"),
                  fmt::format("{}: give one objective: deflection_target_mm or minimize", doc.where("/objective")));
   p.deflection_target = objective.contains("deflection_target_mm");

@@ -134,16 +134,10 @@ void run_sweep_with_workers(const SweepPlan& plan, const fs::path& dir, const Sw
     running.erase(it);
     std::optional<CaseResult> result = read_done_case(dir, r.c.name, r.c.values);
     if (!result && r.over_time) {
-      CaseResult late;
-      late.index = r.c.index;
-      late.name = r.c.name;
-      late.label = r.c.label;
-      late.values = r.c.values;
-      late.status = "timed_out";
-      late.reason = fmt::format("ran longer than the time limit for a case ({:g} s) and was stopped", w.case_time_limit_s);
-      late.runtime_s = now_s() - r.start_s;
-      write_case_record(dir, late);
-      result = late;
+      result = case_record(r.c.index, r.c.name, r.c.label, r.c.values, "timed_out",
+                           fmt::format("ran longer than the time limit for a case ({:g} s) and was stopped", w.case_time_limit_s));
+      result->runtime_s = now_s() - r.start_s;
+      write_case_record(dir, *result);
     }
     if (!result) {
       const fs::path record = case_folder(dir, r.c.name) / "case.json";
@@ -151,15 +145,9 @@ void run_sweep_with_workers(const SweepPlan& plan, const fs::path& dir, const Sw
     }
     if (!result && watch.signal()) continue;  // stopped by the interrupt: it runs again next time
     if (!result) {
-      CaseResult failed;
-      failed.index = r.c.index;
-      failed.name = r.c.name;
-      failed.label = r.c.label;
-      failed.values = r.c.values;
-      failed.status = "failed";
-      failed.reason = fmt::format("{} (see {})", exit_words(status), (fs::path("cases") / r.c.name / "worker.log").string());
-      write_case_record(dir, failed);
-      result = failed;
+      result = case_record(r.c.index, r.c.name, r.c.label, r.c.values, "failed",
+                           fmt::format("{} (see {})", exit_words(status), (fs::path("cases") / r.c.name / "worker.log").string()));
+      write_case_record(dir, *result);
     }
     progress.case_done(*result, now_s() - r.start_s);
   }

@@ -44,13 +44,7 @@ CaseResult run_case_here(const SweepPlan& plan, const SweepCase& c, const fs::pa
   } catch (const Interrupted&) {
     throw;
   } catch (const std::exception& e) {  // the environment (a full disk, memory): recorded, the sweep goes on
-    CaseResult failed;
-    failed.index = c.index;
-    failed.name = c.name;
-    failed.label = c.label;
-    failed.values = c.values;
-    failed.status = "failed";
-    failed.reason = e.what();
+    const CaseResult failed = case_record(c.index, c.name, c.label, c.values, "failed", e.what());
     write_case_record(dir, failed);
     return failed;
   }

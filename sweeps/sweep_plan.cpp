@@ -51,10 +51,7 @@ VariableSpec read_variable(const JsonDocument& doc, const std::string& name, con
   }
   NEEDLE_REQUIRE(spec.is_object(), fmt::format("{}: give '{}' as a list [a, b, ...] or a range {{\"from\": a, \"to\": b, \"count\": n}}",
                                                doc.where(pointer), name));
-  for (const auto& item : spec.items())
-    NEEDLE_REQUIRE(item.key() == "from" || item.key() == "to" || item.key() == "count",
-                   fmt::format("{}: unknown key '{}' in the range of '{}' (known: from, to, count)", doc.where(pointer + "/" + json_pointer_token(item.key())),
-                               item.key(), name));
+  refuse_unknown_keys(doc, spec, pointer, {"from", "to", "count"});
   NEEDLE_REQUIRE(spec.contains("from") && spec.contains("to") && spec.at("from").is_number() && spec.at("to").is_number(),
                  fmt::format("{}: the range of '{}' needs numbers 'from' and 'to'", doc.where(pointer), name));
   v.range = true;
@@ -120,12 +117,7 @@ SweepPlan read_sweep_file(const std::string& path) {
   plan.source = path;
   plan.base = read_design_base(doc);
   const json& v = doc.value;
-  for (const auto& item : v.items()) {
-    static const std::vector<std::string> known = {"base", "model", "set", "variables", "design"};
-    NEEDLE_REQUIRE(std::find(known.begin(), known.end(), item.key()) != known.end(),
-                   fmt::format("{}: unknown key '{}' (a sweep file has base, model, set, variables and design; docs/sweeps.md)",
-                               doc.where("/" + json_pointer_token(item.key())), item.key()));
-  }
+  refuse_unknown_keys(doc, v, "", {"base", "model", "set", "variables", "design"});
   if (v.contains("design") && v.at("design").is_object() && v.at("design").contains("cases")) return read_explicit_cases(doc, std::move(plan));
   NEEDLE_REQUIRE(v.contains("variables") && v.at("variables").is_object() && !v.at("variables").empty(),
                  fmt::format("{}: give 'variables': an object of design variables, e.g. {{\"d_a_mm\": {{\"from\": -0.4, \"to\": 0.5, \"count\": 10}}}}",
@@ -141,9 +133,7 @@ SweepPlan read_sweep_file(const std::string& path) {
       NEEDLE_REQUIRE(d.is_object() && d.size() == 1 && d.contains("latin_hypercube") && d.at("latin_hypercube").is_object(),
                      fmt::format("{}: design must be \"grid\" or {{\"latin_hypercube\": {{\"samples\": n, \"seed\": s}}}}", doc.where("/design")));
       const json& lhs = d.at("latin_hypercube");
-      for (const auto& item : lhs.items())
-        NEEDLE_REQUIRE(item.key() == "samples" || item.key() == "seed",
-                       fmt::format("{}: unknown key '{}' (known: samples, seed)", doc.where("/design/latin_hypercube/" + json_pointer_token(item.key())), item.key()));
+      refuse_unknown_keys(doc, lhs, "/design/latin_hypercube", {"samples", "seed"});
       NEEDLE_REQUIRE(lhs.contains("samples") && lhs.at("samples").is_number_integer() && lhs.at("samples").get<long>() >= 1 &&
                          lhs.at("samples").get<long>() <= kMaxCases,
                      fmt::format("{}: 'samples' must be a whole number from 1 to {}", doc.where("/design/latin_hypercube"), kMaxCases));
