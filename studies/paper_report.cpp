@@ -11,6 +11,7 @@
 
 #include "runs/csv_table.h"
 #include "runs/json_file.h"
+#include "runs/run_summary.h"
 #include "studies/run_model_description.h"
 #include "runs/scene.h"
 #include "studies/target_gaps.h"
@@ -46,19 +47,20 @@ NeedleRun read_run(const std::string& out_dir, const std::string& name) {
   const std::string summary_path = (fs::path(r.folder) / "summary.json").string();
   NEEDLE_REQUIRE(fs::exists(summary_path), fmt::format("no run of {}: '{}' is missing (run `needle paper` without --report-only first)", name, summary_path));
   const json s = read_json_file(summary_path, "run summary");
-  r.status = s.value("status", std::string("unknown"));
-  r.reason = s.value("reason", std::string());
-  r.deflection_mm = number_or_nan(s, "deflection_mm");
-  r.insertion_mm = number_or_nan(s, "insertion_mm");
-  r.runtime_s = number_or_nan(s, "runtime_s");
-  r.max_energy_error = number_or_nan(s, "max_energy_balance_error");
-  r.max_penetration_mm = number_or_nan(s, "max_penetration_mm");
+  const RunOutcome o = run_outcome(s);
+  r.status = o.status;
+  r.reason = o.reason;
+  r.deflection_mm = o.deflection_mm;
+  r.insertion_mm = o.insertion_mm;
+  r.runtime_s = o.runtime_s;
+  r.max_energy_error = o.max_energy_balance_error;
+  r.max_penetration_mm = o.max_penetration_mm;
   r.bonds_broken = s.value("bonds_broken", 0L);
   r.bonds_cut_by_needle = s.value("bonds_cut_by_needle", 0L);
-  r.particles_inside = s.value("particles_inside", 0L);
-  r.steps = s.value("steps", 0L);
+  r.particles_inside = o.particles_inside;
+  r.steps = o.steps;
+  r.groove_fill = o.groove_fill;
   if (s.contains("groove") && s["groove"].is_object()) {
-    r.groove_fill = number_or_nan(s["groove"], "groove_fill");
     r.floor_contact_fraction = number_or_nan(s["groove"], "floor_contact_fraction");
     r.mean_gap_mm = number_or_nan(s["groove"], "mean_gap_mm");
   }

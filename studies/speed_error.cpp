@@ -10,6 +10,7 @@
 #include "geometry/mesh_io.h"
 #include "plot/line_plot.h"
 #include "runs/json_file.h"
+#include "runs/run_summary.h"
 
 namespace needle {
 namespace {
@@ -31,13 +32,14 @@ SpeedErrorCase speed_error_case(const std::string& needle, const std::string& le
   SpeedErrorCase c;
   c.needle = needle;
   c.level = level;
-  c.status = s.value("status", std::string("unknown"));
-  c.reason = s.value("reason", std::string());
-  c.runtime_s = number_or_nan(s, "runtime_s");
-  c.deflection_mm = number_or_nan(s, "deflection_mm");
-  c.max_penetration_mm = number_or_nan(s, "max_penetration_mm");
-  c.max_energy_balance_error = number_or_nan(s, "max_energy_balance_error");
-  c.coupling_steps = s.value("steps", 0L);
+  const RunOutcome o = run_outcome(s);
+  c.status = o.status;
+  c.reason = o.reason;
+  c.runtime_s = o.runtime_s;
+  c.deflection_mm = o.deflection_mm;
+  c.max_penetration_mm = o.max_penetration_mm;
+  c.max_energy_balance_error = o.max_energy_balance_error;
+  c.coupling_steps = o.steps;
   c.needle_steps = s.value("needle_steps", 0L);
   c.max_particles_inside = s.value("max_particles_inside", 0);
   c.error_vs_reference_mm = c.error_vs_full_mm = kNaN;

@@ -13,6 +13,7 @@
 #include "runs/json_file.h"
 #include "runs/model_levels.h"
 #include "runs/recipe_json.h"
+#include "runs/run_summary.h"
 
 namespace needle {
 namespace fs = std::filesystem;
@@ -303,16 +304,16 @@ CaseResult run_design_case(const DesignBase& base, int index, const std::string&
     return r;
   }
   r.run_folder = fs::path("cases") / case_name / "run";
-  const json summary = read_json_file((dir / "run" / "summary.json").string(), "run summary");
-  r.status = summary.value("status", std::string("failed"));
-  r.reason = summary.value("reason", std::string());
-  r.deflection_mm = number_or_nan(summary, "deflection_mm");
-  r.insertion_mm = number_or_nan(summary, "insertion_mm");
-  r.runtime_s = number_or_nan(summary, "runtime_s");
-  r.max_energy_balance_error = number_or_nan(summary, "max_energy_balance_error");
-  r.max_penetration_mm = number_or_nan(summary, "max_penetration_mm");
-  r.particles_inside = summary.value("particles_inside", -1L);
-  if (summary.contains("groove")) r.groove_fill = number_or_nan(summary.at("groove"), "groove_fill");
+  const RunOutcome o = run_outcome(read_json_file((dir / "run" / "summary.json").string(), "run summary"));
+  r.status = o.status;
+  r.reason = o.reason;
+  r.deflection_mm = o.deflection_mm;
+  r.insertion_mm = o.insertion_mm;
+  r.runtime_s = o.runtime_s;
+  r.max_energy_balance_error = o.max_energy_balance_error;
+  r.max_penetration_mm = o.max_penetration_mm;
+  r.particles_inside = o.particles_inside;
+  r.groove_fill = o.groove_fill;
   const fs::path forces_file = dir / "run" / "facet_forces.csv";
   if (fs::exists(forces_file)) {
     const CsvTable forces = read_csv_table(forces_file.string());

@@ -1,0 +1,22 @@
+#include "runs/run_summary.h"
+
+#include "runs/json_file.h"
+
+namespace needle {
+
+RunOutcome run_outcome(const nlohmann::json& s) {
+  RunOutcome o;
+  o.status = s.value("status", std::string("unknown"));
+  o.reason = s.value("reason", std::string());
+  o.deflection_mm = number_or_nan(s, "deflection_mm");
+  o.insertion_mm = number_or_nan(s, "insertion_mm");
+  o.runtime_s = number_or_nan(s, "runtime_s");
+  o.max_energy_balance_error = number_or_nan(s, "max_energy_balance_error");
+  o.max_penetration_mm = number_or_nan(s, "max_penetration_mm");
+  if (s.contains("groove") && s["groove"].is_object()) o.groove_fill = number_or_nan(s["groove"], "groove_fill");
+  o.particles_inside = s.value("particles_inside", 0L);
+  o.steps = s.value("steps", 0L);
+  return o;
+}
+
+}  // namespace needle

@@ -1,0 +1,21 @@
+#pragma once
+// The entries of a run's summary.json that every reader of finished runs wants (the paper's report, the
+// speed-against-error table, a design study's case): one place that knows their keys.
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace needle {
+
+struct RunOutcome {
+  std::string status = "unknown", reason;  // finished, stopped, interrupted (status "unknown": the key is missing)
+  double deflection_mm = std::nan(""), insertion_mm = std::nan(""), runtime_s = std::nan("");
+  double max_energy_balance_error = std::nan(""), max_penetration_mm = std::nan("");
+  double groove_fill = std::nan("");  // NaN without a groove
+  long particles_inside = 0, steps = 0;
+};
+
+// Missing numbers read as NaN (or 0 for the counts).
+RunOutcome run_outcome(const nlohmann::json& summary);
+
+}  // namespace needle
