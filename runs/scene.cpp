@@ -286,20 +286,22 @@ json scene_to_json(const Scene& s) {
 
 namespace needle {
 
-Scene apply_scene_settings(const Scene& scene, const std::vector<std::string>& settings) {
+Scene apply_scene_settings(const Scene& scene, const std::vector<std::string>& settings, const std::string& source) {
   if (settings.empty()) return scene;
+  // How a setting is named in messages: "--set key=value", or the setting alone.
+  auto named = [&](const std::string& setting) { return source.empty() ? setting : source + " " + setting; };
   json j = scene_to_json(scene);
   std::string given;
   for (const std::string& setting : settings) {
     given += (given.empty() ? "" : " ") + setting;
     const size_t eq = setting.find('=');
-    NEEDLE_REQUIRE(eq != std::string::npos && eq > 0, fmt::format("--set {}: give key=value, e.g. --set tissue.material.E_MPa=0.1", setting));
+    NEEDLE_REQUIRE(eq != std::string::npos && eq > 0, fmt::format("{}: give key=value, e.g. {}", named(setting), named("tissue.material.E_MPa=0.1")));
     const std::string key = setting.substr(0, eq), value = setting.substr(eq + 1);
     std::vector<std::string> path;
     for (size_t start = 0;;) {
       const size_t dot = key.find('.', start);
       path.push_back(key.substr(start, dot == std::string::npos ? std::string::npos : dot - start));
-      NEEDLE_REQUIRE(!path.back().empty(), fmt::format("--set {}: '{}' is not a dotted scene key (docs/scenes.md)", setting, key));
+      NEEDLE_REQUIRE(!path.back().empty(), fmt::format("{}: '{}' is not a dotted scene key (docs/scenes.md)", named(setting), key));
       if (dot == std::string::npos) break;
       start = dot + 1;
     }
@@ -307,7 +309,7 @@ Scene apply_scene_settings(const Scene& scene, const std::vector<std::string>& s
     for (size_t k = 0; k + 1 < path.size(); ++k) {
       json& next = (*section)[path[k]];
       if (next.is_null()) next = json::object();
-      NEEDLE_REQUIRE(next.is_object(), fmt::format("--set {}: {} is a value, not a section", setting, path[k]));
+      NEEDLE_REQUIRE(next.is_object(), fmt::format("{}: {} is a value, not a section", named(setting), path[k]));
       section = &next;
     }
     const std::string& leaf = path.back();
@@ -331,7 +333,7 @@ Scene apply_scene_settings(const Scene& scene, const std::vector<std::string>& s
     std::string message = e.what();
     const size_t colon = message.rfind("--set:", 0) == 0 ? message.find(": ") : std::string::npos;
     if (colon != std::string::npos) message = message.substr(colon + 2);
-    throw InputError(fmt::format("--set {}: {}", given, message));
+    throw InputError(fmt::format("{}: {}", named(given), message));
   }
 }
 

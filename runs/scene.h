@@ -104,6 +104,7 @@ nlohmann::json scene_to_json(const Scene& scene);
 // (numbers, true/false, [lists]) and as text otherwise (SB, stiffening_elastic, 3 cm). Setting one of a key's
 // forms replaces the other (travel replaces travel_mm), and one needle source replaces the other. The scene
 // reader checks the result: anything it refuses (an unknown key, a bad value) is an InputError naming --set.
-Scene apply_scene_settings(const Scene& scene, const std::vector<std::string>& settings);
+// source names the settings in messages ("--set"; empty: the settings alone, as a study file's keys).
+Scene apply_scene_settings(const Scene& scene, const std::vector<std::string>& settings, const std::string& source = "--set");
 
 }  // namespace needle

@@ -154,12 +154,7 @@ CaseSetup case_setup(const DesignBase& b, const json& values) {
     angles_given = angles_given || name != "d_a_mm";
   }
   CaseSetup setup;
-  try {
-    setup.scene = apply_scene_settings(scene, settings);
-  } catch (const InputError& e) {  // worded for --set; here the key is a variable or a key of "set"
-    const std::string what = e.what();
-    throw InputError(what.rfind("--set ", 0) == 0 ? what.substr(6) : what);
-  }
+  setup.scene = apply_scene_settings(scene, settings, "");  // the keys are the study file's variables and "set", not --set flags
   NeedleScene& needle = setup.scene.needle;
   if (angles_given) {
     Rod rod;
