@@ -27,10 +27,7 @@ bool evaluate_row(RkShapeFunctions& rk, std::int64_t row, const Eigen::Vector3d&
       ++active;
     }
   auto zero_row = [&] {
-    for (std::int64_t e = begin; e < end; ++e) {
-      rk.psi[static_cast<size_t>(e)] = 0;
-      rk.grad[static_cast<size_t>(e)] = {0, 0, 0};
-    }
+    for (std::int64_t e = begin; e < end; ++e) set_rk_entry(rk, e, 0, {0, 0, 0});
     return false;
   };
   if (active < 4) return zero_row();
@@ -63,8 +60,7 @@ bool evaluate_row(RkShapeFunctions& rk, std::int64_t row, const Eigen::Vector3d&
 
   for (std::int64_t e = begin; e < end; ++e) {
     if (rk.cut[static_cast<size_t>(e)]) {
-      rk.psi[static_cast<size_t>(e)] = 0;
-      rk.grad[static_cast<size_t>(e)] = {0, 0, 0};
+      set_rk_entry(rk, e, 0, {0, 0, 0});
       continue;
     }
     const std::int32_t j = rk.centre[static_cast<size_t>(e)];
@@ -74,13 +70,12 @@ bool evaluate_row(RkShapeFunctions& rk, std::int64_t row, const Eigen::Vector3d&
     const double dw_dr = r > 0 ? cubic_bspline_derivative(r / a) / a : 0.0;
     const Vec4 H(1.0, d.x() * inv_scale, d.y() * inv_scale, d.z() * inv_scale);
     const double bH = b.dot(H);
-    rk.psi[static_cast<size_t>(e)] = bH * w;
     Vec3 g;
     for (int k = 0; k < 3; ++k) {
       const double dw = r > 0 ? dw_dr * d[k] / r : 0.0;
       g[static_cast<size_t>(k)] = db[static_cast<size_t>(k)].dot(H) * w + b[k + 1] * inv_scale * w + bH * dw;
     }
-    rk.grad[static_cast<size_t>(e)] = g;
+    set_rk_entry(rk, e, bH * w, g);
   }
   return true;
 }
@@ -129,12 +124,17 @@ RkShapeFunctions build_rk_shape_functions(const NeighbourLists& lists, const Eig
   for (std::int64_t j = 0; j < num_centres; ++j) rk.column_offset[static_cast<size_t>(j + 1)] += rk.column_offset[static_cast<size_t>(j)];
   rk.column_entry.resize(rk.centre.size());
   rk.column_row.resize(rk.centre.size());
+  rk.column_value.resize(rk.centre.size());
+  rk.entry_slot.resize(rk.centre.size());
   std::vector<std::int64_t> fill(rk.column_offset.begin(), rk.column_offset.end() - 1);
   for (std::int64_t i = 0; i < rk.rows(); ++i)
     for (std::int64_t e = rk.offset[static_cast<size_t>(i)]; e < rk.offset[static_cast<size_t>(i + 1)]; ++e) {
       const std::int64_t slot = fill[static_cast<size_t>(rk.centre[static_cast<size_t>(e)])]++;
       rk.column_entry[static_cast<size_t>(slot)] = e;
       rk.column_row[static_cast<size_t>(slot)] = static_cast<std::int32_t>(i);
+      const Vec3& g = rk.grad[static_cast<size_t>(e)];
+      rk.column_value[static_cast<size_t>(slot)] = {rk.psi[static_cast<size_t>(e)], g[0], g[1], g[2]};
+      rk.entry_slot[static_cast<size_t>(e)] = slot;
     }
   return rk;
 }

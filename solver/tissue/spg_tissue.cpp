@@ -30,6 +30,19 @@ Mat3d gather_gradient(const RkShapeFunctions& rk, std::int64_t i, const std::vec
   return F;
 }
 
+// Both of the above in one pass over row i (each sum in the same order as alone, so the same bits).
+void gather_defect_and_gradient(const RkShapeFunctions& rk, std::int64_t i, const std::vector<Vec3d>& x, Vec3d& defect, Mat3d& F) {
+  Vec3d smoothed = Vec3d::Zero();
+  F.setZero();
+  for (std::int64_t e = rk.offset[static_cast<size_t>(i)]; e < rk.offset[static_cast<size_t>(i + 1)]; ++e) {
+    const Vec3d& xc = x[static_cast<size_t>(rk.centre[static_cast<size_t>(e)])];
+    smoothed += rk.psi[static_cast<size_t>(e)] * xc;
+    const Vec3& g = rk.grad[static_cast<size_t>(e)];
+    F.noalias() += xc * Eigen::RowVector3d(g[0], g[1], g[2]);
+  }
+  defect = x[static_cast<size_t>(i)] - smoothed;
+}
+
 }  // namespace
 
 SpgTissue::SpgTissue(const ParticleSet& set, const TissueMaterial& material, const SpgOptions& options)
@@ -130,16 +143,18 @@ ForceReport SpgTissue::compute_forces(double dt_ms) {
   parallel_for(n, [&](std::int64_t begin, std::int64_t end) {
     for (std::int64_t i = begin; i < end; ++i) {
       const size_t s = static_cast<size_t>(i);
-      defect_[s] = rk_.valid[s] ? gather_defect(rk_, i, p_.position_mm) : Vec3d::Zero();
-      p_.defect_mm[s] = defect_[s].norm();
       if (!rk_.valid[s]) {
+        defect_[s].setZero();
+        p_.defect_mm[s] = 0;
         piola_volume_[s].setZero();
         p_.stress_MPa[s].setZero();
         reset_material_state(s);
         p_.effective_strain[s] = p_.plastic_strain[s];
         continue;
       }
-      const Mat3d F = gather_gradient(rk_, i, p_.position_mm);
+      Mat3d F;
+      gather_defect_and_gradient(rk_, i, p_.position_mm, defect_[s], F);
+      p_.defect_mm[s] = defect_[s].norm();
       const double J = F.determinant();
       const bool collapsed = !(J > kMinJacobian) || !F.allFinite();
       if (!crack_face_support_holds(F, J)) {
@@ -200,11 +215,10 @@ ForceReport SpgTissue::compute_forces(double dt_ms) {
       const size_t s = static_cast<size_t>(j);
       Vec3d f = penalty ? Vec3d(-stiffness_[s] * defect_[s]) : Vec3d::Zero();
       for (std::int64_t c = rk_.column_offset[s]; c < rk_.column_offset[s + 1]; ++c) {
-        const std::int64_t e = rk_.column_entry[static_cast<size_t>(c)];
         const size_t i = static_cast<size_t>(rk_.column_row[static_cast<size_t>(c)]);
-        const Vec3& g = rk_.grad[static_cast<size_t>(e)];
-        f.noalias() -= piola_volume_[i] * Vec3d(g[0], g[1], g[2]);
-        if (penalty) f += stiffness_[i] * rk_.psi[static_cast<size_t>(e)] * defect_[i];
+        const std::array<double, 4>& value = rk_.column_value[static_cast<size_t>(c)];  // psi, grad
+        f.noalias() -= piola_volume_[i] * Vec3d(value[1], value[2], value[3]);
+        if (penalty) f += stiffness_[i] * value[0] * defect_[i];
       }
       p_.force_N[s] = f;
     }
@@ -335,10 +349,7 @@ bool SpgTissue::crack_face_support_holds(const Mat3d& F, double J) const {
 
 void SpgTissue::detach(size_t s) {
   rk_.valid[s] = 0;
-  for (std::int64_t e = rk_.offset[s]; e < rk_.offset[s + 1]; ++e) {
-    rk_.psi[static_cast<size_t>(e)] = 0;
-    rk_.grad[static_cast<size_t>(e)] = {0, 0, 0};
-  }
+  for (std::int64_t e = rk_.offset[s]; e < rk_.offset[s + 1]; ++e) set_rk_entry(rk_, e, 0, {0, 0, 0});
   defect_[s].setZero();
   piola_volume_[s].setZero();
   p_.stress_MPa[s].setZero();

@@ -124,3 +124,38 @@ TEST_CASE("Rows rebuilt without cut entries keep reproduction; too few entries i
   rebuild_rk_rows(rk, {row}, set.x_mm, set.x_mm, r);
   CHECK_FALSE(rk.valid[row]);
 }
+
+TEST_CASE("The transpose's copy of the values follows every rebuilt and cleared row", "[solver][rk]") {
+  const ParticleSet set = needle_test::jittered(needle_test::free_box({0, 0, 0}, {3, 3, 3}, 0.5), 0.2);
+  const Eigen::VectorXd r = radii(set, 1.8);
+  RkShapeFunctions rk = build_rk_shape_functions(set.x_mm, r);
+  const auto mismatches = [&rk] {
+    int count = 0;
+    for (std::int64_t c = 0; c < rk.entries(); ++c) {
+      const std::int64_t e = rk.column_entry[static_cast<size_t>(c)];
+      const std::array<double, 4>& v = rk.column_value[static_cast<size_t>(c)];
+      const Vec3& g = rk.grad[static_cast<size_t>(e)];
+      if (rk.entry_slot[static_cast<size_t>(e)] != c || v[0] != rk.psi[static_cast<size_t>(e)] || v[1] != g[0] || v[2] != g[1] || v[3] != g[2]) ++count;
+    }
+    return count;
+  };
+  REQUIRE(rk.column_value.size() == rk.centre.size());
+  CHECK(mismatches() == 0);
+  // Cut every other entry of a few rows and rebuild them: their values change, and so must the copies.
+  std::vector<std::int64_t> rows = {3, 40, 77};
+  const std::vector<double> psi_before = rk.psi;
+  for (std::int64_t row : rows)
+    for (std::int64_t e = rk.offset[static_cast<size_t>(row)]; e < rk.offset[static_cast<size_t>(row + 1)]; e += 2)
+      if (rk.centre[static_cast<size_t>(e)] != row) rk.cut[static_cast<size_t>(e)] = 1;
+  rebuild_rk_rows(rk, rows, set.x_mm, set.x_mm, r);
+  CHECK(rk.psi != psi_before);
+  CHECK(mismatches() == 0);
+  // A row cleared entry by entry (a particle that stops integrating) clears its copies.
+  for (std::int64_t e = rk.offset[5]; e < rk.offset[6]; ++e) set_rk_entry(rk, e, 0, {0, 0, 0});
+  CHECK(mismatches() == 0);
+  // Columns gather the same sums as rows do: sum over all entries of psi, by rows and by columns.
+  double by_rows = 0, by_columns = 0;
+  for (double p : rk.psi) by_rows += std::abs(p);
+  for (const std::array<double, 4>& v : rk.column_value) by_columns += std::abs(v[0]);
+  CHECK(by_columns == Approx(by_rows).epsilon(1e-12));
+}
