@@ -30,10 +30,10 @@ void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
   if (travel_given || speed_given || decel_given || hold_given)
     scene.motion.validate(travel_given ? "--travel-mm" : speed_given ? "--speed-m-per-s" : decel_given ? "--decel-time-ms" : "--hold-ms");
   if (given(o.spacing_mm, "--spacing-mm")) scene.tissue.spacing_mm = o.spacing_mm;
-  if (o.path_refinement != 0) {
-    NEEDLE_REQUIRE(o.path_refinement >= 1 && o.path_refinement <= 8,
-                   fmt::format("--path-refinement must be an integer from 1 to 8 (got {})", o.path_refinement));
-    scene.tissue.path_refinement = o.path_refinement;
+  if (o.path_refinement) {
+    NEEDLE_REQUIRE(*o.path_refinement >= 1 && *o.path_refinement <= 8,
+                   fmt::format("--path-refinement must be an integer from 1 to 8 (got {})", *o.path_refinement));
+    scene.tissue.path_refinement = *o.path_refinement;
   }
   if (given(o.mesh_size_mm, "--mesh-size-mm")) scene.needle.mesh.size_mm = o.mesh_size_mm;
   if (o.no_needle_cut) scene.tissue.separation.needle_cut = false;
@@ -184,7 +184,7 @@ std::string scene_override_arguments(const SceneOverrides& o) {
   number("--travel-mm", o.travel_mm);
   number("--spacing-mm", o.spacing_mm);
   number("--mesh-size-mm", o.mesh_size_mm);
-  if (o.path_refinement != 0) line += fmt::format(" --path-refinement {}", o.path_refinement);
+  if (o.path_refinement) line += fmt::format(" --path-refinement {}", *o.path_refinement);
   if (o.no_needle_cut) line += " --no-needle-cut";
   number("--tissue-nu", o.tissue_nu);
   number("--tissue-friction", o.tissue_friction);

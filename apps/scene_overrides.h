@@ -4,6 +4,7 @@
 // regenerates a result.
 #include <CLI/CLI.hpp>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,7 +16,7 @@ namespace needle {
 struct SceneOverrides {
   std::string model;  // the model level (runs/model_levels.h); empty: the scene's
   double travel_mm = std::nan(""), spacing_mm = std::nan(""), mesh_size_mm = std::nan("");
-  int path_refinement = 0;  // 0: the scene's
+  std::optional<int> path_refinement;  // none: the scene's
   bool no_needle_cut = false;  // tissue separates by bond failure alone (the paper's model)
   double tissue_nu = std::nan(""), tissue_friction = std::nan("");  // the card's Poisson ratio; needle-tissue friction
   std::string tissue_law;  // empty: the scene's (TissueLaw names)

@@ -232,6 +232,7 @@ TEST_CASE("needle run: no needle, two needles or a bad number exit 2 with one li
                                  "run --preset SB --travel-mm -3 --out " + (dir / "a").string(),
                                  "run --preset XX --out " + (dir / "a").string(),
                                  "run --preset SB --path-refinement 9 --out " + (dir / "a").string(),
+                                 "run --preset SB --path-refinement 0 --out " + (dir / "a").string(),
                                  "run --preset SB --tissue-nu 0.5 --out " + (dir / "a").string(),
                                  "run --preset SB --tissue-friction -0.1 --out " + (dir / "a").string(),
                                  "run --preset SB --tissue-law neo_hookean --out " + (dir / "a").string(),
