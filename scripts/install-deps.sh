@@ -1,5 +1,7 @@
 #!/usr/bin/env bash
 # Installs every build and test dependency of the project from Debian's packages.
+# --checking also installs what the checking build needs (scripts/test-sanitizers.sh): clang with its sanitizer
+# and libFuzzer runtimes.
 # Safe to run again: apt-get skips what is already there.
 set -euo pipefail
 SUDO=""
@@ -16,8 +18,9 @@ PACKAGES=(
   libpng-dev libfreetype-dev fonts-dejavu-core
   libsuitesparse-dev libspectra-dev
   libnlopt-dev libnlopt-cxx-dev libopenmpi-dev openmpi-bin
-  python3-meshio
+  python3-meshio python3-vtk9
 )
+if [ "${1:-}" = "--checking" ]; then PACKAGES+=(clang libclang-rt-14-dev); fi
 missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
