@@ -23,7 +23,9 @@ std::vector<PaperReferenceNeedle> read_paper_reference(const std::string& path) 
   const json j = read_json_file(path, "paper's reference table");
   NEEDLE_REQUIRE(j.contains("needles") && j["needles"].is_object(), fmt::format("{}: no 'needles' object", path));
   std::vector<PaperReferenceNeedle> out;
-  for (const auto& [name, v] : j["needles"].items()) {
+  for (const auto& item : j["needles"].items()) {
+    const std::string& name = item.key();
+    const json& v = item.value();
     PaperReferenceNeedle r;
     r.name = name;
     auto number = [&](const char* key) {

@@ -124,7 +124,10 @@ void map_over(const fs::path& dir, const std::string& x_name, const std::string&
   xs.erase(std::unique(xs.begin(), xs.end()), xs.end());
   std::sort(ys.begin(), ys.end());
   ys.erase(std::unique(ys.begin(), ys.end()), ys.end());
-  HeatMap deflection{fmt::format("Tip deflection (mm) over {} and {}", x_name, y_name), x_name, y_name};
+  HeatMap deflection;
+  deflection.title = fmt::format("Tip deflection (mm) over {} and {}", x_name, y_name);
+  deflection.x_label = x_name;
+  deflection.y_label = y_name;
   deflection.x = xs;
   deflection.y = ys;
   deflection.values.assign(ys.size(), std::vector<double>(xs.size(), std::nan("")));

@@ -24,7 +24,10 @@ TEST_CASE("A heat map's cells take their values' colours on a scale white at its
   CHECK(half == Rgb{static_cast<unsigned char>(std::lround(255 + (178 - 255) * 0.5)), static_cast<unsigned char>(std::lround(255 + (24 - 255) * 0.5)),
                     static_cast<unsigned char>(std::lround(255 + (43 - 255) * 0.5))});
 
-  HeatMap map{"t", "x", "y"};
+  HeatMap map;
+  map.title = "t";
+  map.x_label = "x";
+  map.y_label = "y";
   map.x = {0.0, 1.0, 2.0};
   map.y = {10.0, 20.0};
   map.values = {{-2.0, 0.0, 1.0}, {2.0, std::nan(""), -1.0}};  // rows: y = 10 (bottom), y = 20 (top)
