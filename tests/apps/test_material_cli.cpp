@@ -10,7 +10,7 @@
 
 namespace fs = std::filesystem;
 
-TEST_CASE("needle material-test --json prints the curve and its error", "[cli][material]") {
+TEST_CASE("needle material-test --json prints the curve and its error", "[cli][material][slow]") {
   const auto r = needle_test::run("material-test --json --max-strain 0.6 --samples 7 --E-MPa 0.1 --rate-law off");
   REQUIRE(r.exit_code == 0);
   const auto report = nlohmann::json::parse(r.out);

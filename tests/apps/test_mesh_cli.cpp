@@ -12,7 +12,7 @@ namespace fs = std::filesystem;
 using needle_test::Result;
 using needle_test::run;
 
-TEST_CASE("needle mesh --preset LMB --order 2 --size-mm 0.2 --half writes a valid T10 mesh", "[apps][cli][mesher]") {
+TEST_CASE("needle mesh --preset LMB --order 2 --size-mm 0.2 --half writes a valid T10 mesh", "[apps][cli][mesher][slow]") {
   const fs::path dir = fs::temp_directory_path() / "needle-mesh-cli-test";
   fs::remove_all(dir);
   fs::create_directories(dir);
@@ -36,7 +36,7 @@ TEST_CASE("needle mesh --preset LMB --order 2 --size-mm 0.2 --half writes a vali
   fs::remove_all(dir);
 }
 
-TEST_CASE("needle mesh and needle particles refuse bad input and write nothing", "[apps][cli][errors]") {
+TEST_CASE("needle mesh and needle particles refuse bad input and write nothing", "[apps][cli][errors][slow]") {
   const fs::path dir = fs::temp_directory_path() / "needle-mesh-cli-errors";
   fs::remove_all(dir);
   fs::create_directories(dir);
@@ -58,7 +58,7 @@ TEST_CASE("needle mesh and needle particles refuse bad input and write nothing",
   fs::remove_all(dir);
 }
 
-TEST_CASE("needle particles: the paper block, classified against an inserted needle", "[apps][cli][particles]") {
+TEST_CASE("needle particles: the paper block, classified against an inserted needle", "[apps][cli][particles][slow]") {
   const fs::path dir = fs::temp_directory_path() / "needle-particles-cli";
   fs::remove_all(dir);
   fs::create_directories(dir);

@@ -44,7 +44,7 @@ TEST_CASE("needle run --model fast runs the implicit needle with the kinematic c
 }
 
 TEST_CASE("needle bench insertion writes one row per needle and level from the runs, reuses finished ones, refuses bad lists",
-          "[apps][lspg][gmsh]") {
+          "[apps][lspg][gmsh][slow]") {
   const fs::path dir = fresh_folder("bench_insertion");
   write(dir / "scene.json", R"({"needle": {"preset": "SB", "length_mm": 26, "mesh": {"order": 1, "size_mm": 0.5}},)"
                             R"("motion": {"accel_time_ms": 0.02, "travel_mm": 0.8}, "cannula": {"enabled": false},)"

@@ -52,10 +52,10 @@ void check_repeats(const std::string& name) {
 
 }  // namespace
 
-TEST_CASE("Regression scene: SB into a small block repeats its stored history bit for bit", "[regression][gmsh]") { check_repeats("sb"); }
+TEST_CASE("Regression scene: SB into a small block repeats its stored history bit for bit", "[regression][gmsh][slow]") { check_repeats("sb"); }
 
-TEST_CASE("Regression scene: every optional model on (slit, crack, cutting pressure, relaxation) repeats bit for bit", "[regression][gmsh]") {
+TEST_CASE("Regression scene: every optional model on (slit, crack, cutting pressure, relaxation) repeats bit for bit", "[regression][gmsh][slow]") {
   check_repeats("models");
 }
 
-TEST_CASE("Regression scene: a rigid needle in the stiffening elastic law repeats bit for bit", "[regression][gmsh]") { check_repeats("rigid"); }
+TEST_CASE("Regression scene: a rigid needle in the stiffening elastic law repeats bit for bit", "[regression][gmsh][slow]") { check_repeats("rigid"); }

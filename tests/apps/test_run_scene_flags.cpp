@@ -18,7 +18,7 @@
 namespace fs = std::filesystem;
 using namespace needle_test;
 
-TEST_CASE("needle run --no-needle-cut: the tissue separates by bond failure alone", "[apps][lspg][gmsh]") {
+TEST_CASE("needle run --no-needle-cut: the tissue separates by bond failure alone", "[apps][lspg][gmsh][slow]") {
   // The same short insertion with and without the needle's cut: the flag turns the cut off and says
   // so in the effective scene; with the cut on, the rod's passage cuts bonds.
   auto run_variant = [](const std::string& name, const std::string& flags) {
@@ -34,7 +34,7 @@ TEST_CASE("needle run --no-needle-cut: the tissue separates by bond failure alon
   CHECK(plain_summary["status"] == "finished");
 }
 
-TEST_CASE("needle run --tissue-law stiffening_elastic: the scene says so and the stiffened tissue resists harder", "[apps][lspg][gmsh]") {
+TEST_CASE("needle run --tissue-law stiffening_elastic: the scene says so and the stiffened tissue resists harder", "[apps][lspg][gmsh][slow]") {
   // The same short insertion at the same E under both laws: the stiffening law adds k eps^n to the same
   // small-strain modulus, so the tissue's reaction on the rod must be larger. The default law is not
   // written into the effective scene (stored scenes and runs stay as they were).
@@ -51,7 +51,7 @@ TEST_CASE("needle run --tissue-law stiffening_elastic: the scene says so and the
   CHECK(stiff_drag_N > 1.2 * card_drag_N);
 }
 
-TEST_CASE("needle run --speed-m-per-s: the scene says so and the drive ends when the closed-form profile does", "[apps][lspg][gmsh]") {
+TEST_CASE("needle run --speed-m-per-s: the scene says so and the drive ends when the closed-form profile does", "[apps][lspg][gmsh][slow]") {
   // The rod's scene ramps 0 -> v in 0.02 ms, then runs at v to 0.8 mm: it ends at
   // t = 0.02 + (0.8 - v 0.02 / 2) / v ms. Halving the speed must nearly double the run's simulated time.
   auto end_of_run = [](const std::string& name, double speed_m_per_s) {
@@ -70,7 +70,7 @@ TEST_CASE("needle run --speed-m-per-s: the scene says so and the drive ends when
 }
 
 TEST_CASE("needle run --hold-ms: the base stops at the travel's end, the drive does no more work, the run ends after the hold",
-          "[apps][lspg][gmsh]") {
+          "[apps][lspg][gmsh][slow]") {
   // The rod's scene at 8 m/s reaches 0.8 mm at t = 0.02 + (0.8 - 0.08) / 8 = 0.11 ms; a 0.06 ms hold follows. While the base is
   // still its reaction does no work, so the drive's work must not change over the hold, while the tissue still moves.
   const RunFiles run = run_rod_into_small_block("hold", "--hold-ms 0.06");
@@ -96,7 +96,7 @@ TEST_CASE("needle run --hold-ms: the base stops at the travel's end, the drive d
 }
 
 TEST_CASE("needle run --tissue-size-mm: the lattice fills the given block, and fixed faces further out hold the tissue less stiffly",
-          "[apps][lspg][gmsh]") {
+          "[apps][lspg][gmsh][slow]") {
   // The lattice has round(size / 0.4) + 1 nodes per axis. The same rod pushed into a block whose fixed faces (y = +-Y/2, z = Z)
   // stand further from it meets tissue that is less confined: it stores less strain energy at every sample of the run.
   // (The rod's drag is not compared: on a lattice six particles long, the contact force of one sample swings by a
@@ -128,7 +128,7 @@ TEST_CASE("needle run --tissue-size-mm: the lattice fills the given block, and f
 }
 
 TEST_CASE("needle run --slit-half-height-mm: the symmetry plane opens behind the tip, and its particles leave the plane",
-          "[apps][lspg][gmsh][slit]") {
+          "[apps][lspg][gmsh][slit][slow]") {
   // The same rod pushed 0.8 mm in, with and without a slit 0.9 mm either side of the rod's axis. The blunt rod pushes the
   // plane's particles within its radius (0.5 mm) ahead of it, so behind its end (x < 0.8) lie those at y = +-0.8, x = 0 and
   // 0.4: four. Once open they may leave the plane, pulled by the tissue beside them.
@@ -148,7 +148,7 @@ TEST_CASE("needle run --slit-half-height-mm: the symmetry plane opens behind the
   CHECK(std::count(out.begin(), out.end(), '\n') == 1);
 }
 
-TEST_CASE("needle run --decel-time-ms: a ramped stop leaves the needle far less ringing than an instantaneous one", "[apps][lspg][gmsh]") {
+TEST_CASE("needle run --decel-time-ms: a ramped stop leaves the needle far less ringing than an instantaneous one", "[apps][lspg][gmsh][slow]") {
   // The steel rod, stopped at once from 8 m/s, keeps its kinetic energy (0.6 mJ for this 6 mm half rod) ringing axially
   // with no damping. Ramped to rest over 0.02 ms, four axial periods (4 L / c = 4.9 us), it keeps a small fraction.
   auto needle_kinetic_in_hold = [](const std::string& name, const std::string& flags, double stop_ms) {
@@ -170,7 +170,7 @@ TEST_CASE("needle run --decel-time-ms: a ramped stop leaves the needle far less 
 }
 
 TEST_CASE("needle run --relaxing-shear-fraction: the scene says so, the relaxed gel drags the rod less, and the balance books the loss",
-          "[apps][lspg][gmsh][viscoelastic]") {
+          "[apps][lspg][gmsh][viscoelastic][slow]") {
   // The rod's 0.11 ms push with 90 % of the shear stress relaxing at tau 0.01 ms: the tissue the rod has passed keeps a tenth
   // of its shear stress, so the rod's drag must fall well below the elastic card's, while the energy balance (the stress
   // power is internal work) still closes. Without the flag the keys are not written (stored scenes and runs stay as they were).
@@ -195,7 +195,7 @@ TEST_CASE("needle run --relaxing-shear-fraction: the scene says so, the relaxed 
 }
 
 TEST_CASE("needle run --cutting-pressure-mpa: the scene says so, the tip pays the cutting work, bad input is refused",
-          "[apps][lspg][gmsh][cutting]") {
+          "[apps][lspg][gmsh][cutting][slow]") {
   // The SB pushed 0.8 mm into the small block with and without a cutting pressure of 0.2 MPa: the key is written only
   // when on; the work goes into the summary and into the balance (which must still close); the needle is held back harder.
   const RunFiles free_cut = run_sb_into_small_block("cutting_free", "");
@@ -229,7 +229,7 @@ TEST_CASE("needle run --cutting-pressure-mpa: the scene says so, the tip pays th
 }
 
 TEST_CASE("needle run --crack-reach-mm: the scene says so, the tip's crack cuts bonds past the rod, bad input is refused",
-          "[apps][lspg][gmsh][crack]") {
+          "[apps][lspg][gmsh][crack][slow]") {
   // The SB pushed 0.8 mm in, with and without a horizontal crack 1 mm long from tip point A (at the rod's bottom, y = -0.5):
   // the lattice's bonds from y = -0.8 to -0.4 cross its plane beside the rod, where the needle's body never is, so the
   // needle alone cuts none of them. The key is written only when on, and the balance still closes.
@@ -270,7 +270,7 @@ TEST_CASE("needle run --crack-reach-mm: the scene says so, the tip's crack cuts 
 }
 
 TEST_CASE("needle run --groove-start-mm: the scene says so, the built needle's groove floor starts there, bad input is refused",
-          "[apps][gmsh][scene]") {
+          "[apps][gmsh][scene][slow]") {
   // The paper does not say where the groove starts. The scene key moves the groove's front wall of any ground tip: the
   // groove box and the mesh's groove_floor nodes must start that far behind A, and the default stays the presets' 3 mm.
   auto groove_front_x = [](const std::string& needle_keys) {
@@ -312,7 +312,7 @@ TEST_CASE("needle run --groove-start-mm: the scene says so, the built needle's g
 }
 
 TEST_CASE("needle run --contact-skin-mm, --contact-stiffness-factor: the scene says so, the solver feels both, bad input is refused",
-          "[apps][lspg][gmsh][contact]") {
+          "[apps][lspg][gmsh][contact][slow]") {
   // The penalty contact's two numerical parameters (solver/contact/needle_tissue_contact.h). The skin holds the particles off the
   // needle's true surface: at stiffness factor 10, without it they sink into the rod until the penalty holds them, with a
   // thin one less, with a thick one (0.04 mm, the default before the skin study) hardly at all (the rod pushed 0.8 mm in).
@@ -352,7 +352,7 @@ TEST_CASE("needle run --contact-skin-mm, --contact-stiffness-factor: the scene s
 }
 
 TEST_CASE("needle run --tissue-entry-x-mm: the block starts there, the rod meets no tissue before it, bad input is refused",
-          "[apps][lspg][gmsh][contact]") {
+          "[apps][lspg][gmsh][contact][slow]") {
   // The flag that shifts the particle lattice against the needle's path (the lattice starts at the entry face), so that a
   // result's run-to-run scatter can be measured. The same block, moved 0.2 mm ahead of the rod's start: the same particles,
   // no contact and no broken bond while the rod's end is short of the face by more than the contact's skin, and the rod's

@@ -72,7 +72,7 @@ TEST_CASE("needle run --set and needle simulate --set change the run's scene; a 
   CHECK(nlohmann::json::parse(summary_file)["insertion_mm"].get<double>() == Approx(0.3).epsilon(1e-9));
 }
 
-TEST_CASE("needle run with no E given takes the shipped SB calibration's and says so", "[apps][lspg][gmsh]") {
+TEST_CASE("needle run with no E given takes the shipped SB calibration's and says so", "[apps][lspg][gmsh][slow]") {
   // The run defaults, shrunk with --set to seconds: a short T4 SB, a small block, 0.8 mm.
   const fs::path dir = fresh_folder("calibrated_default");
   const std::string shrink =

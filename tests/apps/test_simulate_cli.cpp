@@ -91,7 +91,7 @@ TEST_CASE("Bad scenes name the file, the line and the key", "[apps][scene]") {
   CHECK(m.find("no bore") != std::string::npos);
 }
 
-TEST_CASE("needle simulate: bad scenes exit non-zero and leave no run folder", "[apps][scene]") {
+TEST_CASE("needle simulate: bad scenes exit non-zero and leave no run folder", "[apps][scene][slow]") {
   const fs::path dir = fresh_folder("bad");
   const std::vector<std::string> scenes = {
       R"({"motion": {"sped_m_per_s": 8}})", R"({"needle": {"material": {"youngs_modulus_MPa": -1}}})",
@@ -108,7 +108,7 @@ TEST_CASE("needle simulate: bad scenes exit non-zero and leave no run folder", "
   }
 }
 
-TEST_CASE("needle simulate: a rod pushed through the cannula writes a complete run folder", "[apps][scene][gmsh]") {
+TEST_CASE("needle simulate: a rod pushed through the cannula writes a complete run folder", "[apps][scene][gmsh][slow]") {
   const fs::path dir = fresh_folder("rod");
   write(dir / "scene.json", R"({
     "needle": {"plain_rod": true, "length_mm": 20, "mesh": {"order": 1, "size_mm": 0.5}},
@@ -151,7 +151,7 @@ TEST_CASE("needle simulate: a rod pushed through the cannula writes a complete r
   CHECK(summary2["deflection_mm"].get<double>() == Approx(summary["deflection_mm"].get<double>()).margin(1e-12));
 }
 
-TEST_CASE("needle stiffness --json reports compliance and frequencies with the beam reference", "[apps][needle][gmsh]") {
+TEST_CASE("needle stiffness --json reports compliance and frequencies with the beam reference", "[apps][needle][gmsh][slow]") {
   const auto r = run("stiffness --plain-rod --free-length-mm 30 --size-mm 0.3 --json");
   REQUIRE(r.exit_code == 0);
   const auto j = nlohmann::json::parse(r.out);
@@ -164,7 +164,7 @@ TEST_CASE("needle stiffness --json reports compliance and frequencies with the b
   CHECK(run("stiffness --preset XX").exit_code == 2);
 }
 
-TEST_CASE("needle run: a rod pushed into a small tissue block writes the coupled run folder", "[apps][lspg][gmsh]") {
+TEST_CASE("needle run: a rod pushed into a small tissue block writes the coupled run folder", "[apps][lspg][gmsh][slow]") {
   const fs::path dir = fresh_folder("insertion");
   const auto r = run_rod_into_block(dir, R"({"size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4})", 1.0, 2);
   INFO(r.out);
@@ -187,7 +187,7 @@ TEST_CASE("needle run: a rod pushed into a small tissue block writes the coupled
   for (const char* field : {"displacement_mm", "plastic_strain", "broken_bonds", "in_contact"}) CHECK(text.find(field) != std::string::npos);
 }
 
-TEST_CASE("needle run: the worker threads do not change a run, bit for bit", "[apps][lspg][gmsh][threads]") {
+TEST_CASE("needle run: the worker threads do not change a run, bit for bit", "[apps][lspg][gmsh][threads][slow]") {
   // Every per-particle kernel is a gather (core/parallel.h): each index writes only its own outputs, so the
   // schedule cannot change a sum's order. The same coupled run on one and on two threads must give the same
   // history, every column of every row, exactly; `paper` and `calibrate` reuse runs across thread counts on this.
@@ -205,7 +205,7 @@ TEST_CASE("needle run: the worker threads do not change a run, bit for bit", "[a
   CHECK(std::abs(one.summary["deflection_mm"].get<double>()) > 0);
 }
 
-TEST_CASE("needle run: path_refinement puts finer particles around the needle's path only", "[apps][lspg][gmsh]") {
+TEST_CASE("needle run: path_refinement puts finer particles around the needle's path only", "[apps][lspg][gmsh][slow]") {
   // Block x 0..2, y -1.2..1.2, z 0..1.2 at 0.4 mm; within |y|, z <= 0.4 mm of the path the spacing halves.
   // Along x the refined band covers the whole length: 2 / 0.2 = 10 intervals. Along y: 0.8 mm at 0.2 and
   // 1.6 mm at 0.4 = 8. Along z: 0.4 at 0.2 and 0.8 at 0.4 = 4. Lattice nodes: 11 x 9 x 5.
@@ -226,7 +226,7 @@ TEST_CASE("needle run: path_refinement puts finer particles around the needle's 
   CHECK_FALSE(fs::exists(dir / "wide"));
 }
 
-TEST_CASE("needle run: no needle, two needles or a bad number exit 2 with one line and no folder", "[apps][lspg]") {
+TEST_CASE("needle run: no needle, two needles or a bad number exit 2 with one line and no folder", "[apps][lspg][slow]") {
   const fs::path dir = fresh_folder("run_bad");
   for (const std::string& args : {"run --out " + (dir / "a").string(), "run --preset SB --d-a 0 --out " + (dir / "a").string(),
                                  "run --preset SB --travel-mm -3 --out " + (dir / "a").string(),
@@ -249,7 +249,7 @@ TEST_CASE("needle run: no needle, two needles or a bad number exit 2 with one li
 }
 
 
-TEST_CASE("needle simulate --overwrite replaces only a run folder the toolkit wrote, never the current folder or one above it", "[apps][sim][gmsh]") {
+TEST_CASE("needle simulate --overwrite replaces only a run folder the toolkit wrote, never the current folder or one above it", "[apps][sim][gmsh][slow]") {
   // A needle-alone scene of a fraction of a second.
   const fs::path dir = fresh_folder("overwrite_guard");
   write(dir / "scene.json", R"({"needle": {"plain_rod": true, "length_mm": 6, "mesh": {"order": 1, "size_mm": 0.5}},)"
@@ -290,7 +290,7 @@ TEST_CASE("needle simulate --overwrite replaces only a run folder the toolkit wr
   CHECK(fs::exists(dir / "run" / "summary.json"));
 }
 
-TEST_CASE("A number flag given NaN or infinity is refused before anything runs, whichever command", "[apps][sim]") {
+TEST_CASE("A number flag given NaN or infinity is refused before anything runs, whichever command", "[apps][sim][slow]") {
   // Options read NaN as "not given": without the check, --travel-mm nan quietly ran the default 30 mm.
   const fs::path dir = fresh_folder("non_finite");
   for (const std::string& args : std::vector<std::string>{"run --preset SB --travel-mm nan", "run --preset SB --tissue-E-MPa inf",
@@ -310,7 +310,7 @@ TEST_CASE("A number flag given NaN or infinity is refused before anything runs, 
   CHECK(!fs::exists(dir / "out"));
 }
 
-TEST_CASE("Unknown flags, values that do not convert and negative counts get the project's one line and exit 2", "[apps][sim]") {
+TEST_CASE("Unknown flags, values that do not convert and negative counts get the project's one line and exit 2", "[apps][sim][slow]") {
   // CLI11's own words used to leak with its own exit codes; negative --threads and --frames quietly became the defaults.
   const fs::path dir = fresh_folder("cli_errors");
   for (const auto& [args, message] : std::vector<std::pair<std::string, std::string>>{
@@ -330,7 +330,7 @@ TEST_CASE("Unknown flags, values that do not convert and negative counts get the
   CHECK(run("run --help").exit_code == 0);
 }
 
-TEST_CASE("Ctrl-C during a run writes what there is, marked interrupted, exits 130 and leaves no scratch folder", "[apps][sim]") {
+TEST_CASE("Ctrl-C during a run writes what there is, marked interrupted, exits 130 and leaves no scratch folder", "[apps][sim][slow]") {
   // The run (sb_quick: about 15 s) is sent SIGINT once its loop has written its first history rows.
   const fs::path dir = fresh_folder("interrupt");
   const fs::path out = dir / "run", partial = dir / ".run.partial" / "history.csv";

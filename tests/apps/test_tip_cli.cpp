@@ -11,7 +11,7 @@ namespace fs = std::filesystem;
 using needle_test::Result;
 using needle_test::run;
 
-TEST_CASE("needle tip --preset LMB --json prints the report", "[apps][cli]") {
+TEST_CASE("needle tip --preset LMB --json prints the report", "[apps][cli][slow]") {
   const Result r = run("tip --preset LMB --json");
   REQUIRE(r.exit_code == 0);
   const auto j = nlohmann::json::parse(r.out);

@@ -51,12 +51,12 @@ TEST_CASE("SB top facet equals the closed form pi R^2 / sin(theta)", "[geometry]
   }
 }
 
-TEST_CASE("preset facet areas within 0.5 % of the smooth solid, full and half", "[geometry][areas]") {
+TEST_CASE("preset facet areas within 0.5 % of the smooth solid, full and half", "[geometry][areas][slow]") {
   for (const std::string& name : preset_names())
     for (bool half : {false, true}) check_facet_areas(preset_recipe(name), half, 0.005);
 }
 
-TEST_CASE("arbitrary multi-bevel tips: facet areas within 0.5 %", "[geometry][areas]") {
+TEST_CASE("arbitrary multi-bevel tips: facet areas within 0.5 %", "[geometry][areas][slow]") {
   std::mt19937 random(20261122);
   std::uniform_real_distribution<double> d_a(-0.42, 0.5), top(15, 35), bevel(8, 20), side(90, 135);
   for (int trial = 0; trial < 6; ++trial) {
@@ -68,7 +68,7 @@ TEST_CASE("arbitrary multi-bevel tips: facet areas within 0.5 %", "[geometry][ar
   CHECK_THROWS_AS(build_cad_solid(multi_bevel_recipe(-0.46)), InputError);
 }
 
-TEST_CASE("groove floor and walls match their closed forms", "[geometry][areas]") {
+TEST_CASE("groove floor and walls match their closed forms", "[geometry][areas][slow]") {
   const CadSolid solid = build_cad_solid(preset_recipe("LMB"));
   const std::vector<double> areas = area_by_tag_mm2(solid.surface);
   const double R = 0.5, h = -0.07, length = 22.0;
@@ -81,7 +81,7 @@ TEST_CASE("groove floor and walls match their closed forms", "[geometry][areas]"
   CHECK(std::abs(areas[solid.surface.tag_index("base")] / (kPi * R * R) - 1) < 0.005);
 }
 
-TEST_CASE("every triangle is tagged and the solid is a closed manifold", "[geometry]") {
+TEST_CASE("every triangle is tagged and the solid is a closed manifold", "[geometry][slow]") {
   for (const std::string& name : preset_names())
     for (bool half : {false, true}) {
       const CadSolid solid = build_cad_solid(preset_recipe(name), half);
@@ -121,7 +121,7 @@ TEST_CASE("every triangle is tagged and the solid is a closed manifold", "[geome
     }
 }
 
-TEST_CASE("chord tolerance trades triangles for accuracy", "[geometry][areas]") {
+TEST_CASE("chord tolerance trades triangles for accuracy", "[geometry][areas][slow]") {
   GrindingRecipe coarse = preset_recipe("HMB"), fine = preset_recipe("HMB");
   coarse.tessellation.chord_tolerance_mm = 4e-3;
   coarse.tessellation.min_segments_per_arc = 4;

@@ -23,7 +23,7 @@ fs::path fresh_dir(const std::string& name) {
 }
 }  // namespace
 
-TEST_CASE("exported files re-import closed, manifold, with the same area and volume", "[geometry][io]") {
+TEST_CASE("exported files re-import closed, manifold, with the same area and volume", "[geometry][io][slow]") {
   const CadSolid solid = build_cad_solid(preset_recipe("LMB"), true);
   const double area = surface_area_mm2(solid.surface), volume = enclosed_volume_mm3(solid.surface);
   const fs::path dir = fresh_dir("io");

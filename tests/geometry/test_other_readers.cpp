@@ -55,7 +55,7 @@ void check_counts(const std::string& out, const std::string& path, const TriSurf
 
 }  // namespace
 
-TEST_CASE("exported STL, ASCII STL, OBJ and PLY are read by meshio with our triangles and area", "[geometry][io]") {
+TEST_CASE("exported STL, ASCII STL, OBJ and PLY are read by meshio with our triangles and area", "[geometry][io][slow]") {
   const CadSolid solid = build_cad_solid(preset_recipe("SB"), true);
   const fs::path dir = fresh_dir("meshio");
   for (const auto& [name, ascii] : kSurfaceFiles) {

@@ -49,7 +49,7 @@ TEST_CASE("facet normals follow the SPEC convention", "[geometry]") {
   CHECK(tip.facets[2].normal.z() > 0);  // side_pos faces +z
 }
 
-TEST_CASE("the solid's most distal vertex is the analytic plane intersection to 1e-9 mm", "[geometry]") {
+TEST_CASE("the solid's most distal vertex is the analytic plane intersection to 1e-9 mm", "[geometry][slow]") {
   for (double d_a : {-0.22, 0.0, 0.37, -0.4, 0.2, 0.48}) {
     for (bool half : {false, true}) {
       const CadSolid solid = build_cad_solid(multi_bevel_recipe(d_a), half);
@@ -67,7 +67,7 @@ TEST_CASE("the solid's most distal vertex is the analytic plane intersection to 
   CHECK((most_distal_point(sb.surface) - Eigen::Vector3d(x_on_bottom, -0.5, 0)).norm() < 1e-9);
 }
 
-TEST_CASE("custom angles still converge at A", "[geometry]") {
+TEST_CASE("custom angles still converge at A", "[geometry][slow]") {
   MultiBevelAngles angles;
   angles.top_tilt_deg = 30;
   angles.bevel_tilt_deg = 15;

@@ -49,7 +49,7 @@ TEST_CASE("preset volumes within 0.5 % of the smooth solid; half model is half",
   }
 }
 
-TEST_CASE("sections: plain rod and grooved section against closed forms", "[geometry][sections]") {
+TEST_CASE("sections: plain rod and grooved section against closed forms", "[geometry][sections][slow]") {
   const CadSolid solid = build_cad_solid(preset_recipe("LMB"));
   const double R = 0.5, h = -0.07;
   const std::vector<SectionProperties> s = surface_sections(solid.surface, {-30.1, -10.1});
@@ -74,7 +74,7 @@ TEST_CASE("sections: plain rod and grooved section against closed forms", "[geom
   CHECK(e.I_z_mm4 == Approx(Iz).epsilon(1e-5));
 }
 
-TEST_CASE("tip sections shrink toward A and agree with the smooth solid", "[geometry][sections]") {
+TEST_CASE("tip sections shrink toward A and agree with the smooth solid", "[geometry][sections][slow]") {
   for (const std::string& name : preset_names()) {
     const CadSolid solid = build_cad_solid(preset_recipe(name));
     std::vector<double> xs;

@@ -17,7 +17,7 @@ double brute_force_distance(const TriSurface& s, const Eigen::Vector3d& p) { ret
 
 }  // namespace
 
-TEST_CASE("level-set distance and sign match brute force near the LMB tip", "[mesher][levelset]") {
+TEST_CASE("level-set distance and sign match brute force near the LMB tip", "[mesher][levelset][slow]") {
   const CadSolid solid = build_cad_solid(preset_recipe("LMB"), false);
   LevelSetOptions options;
   options.voxel_mm = 0.01;
@@ -50,7 +50,7 @@ TEST_CASE("level-set distance and sign match brute force near the LMB tip", "[me
   CHECK(worst < 0.5 * options.voxel_mm);
 }
 
-TEST_CASE("level-set sign is right far from the surface, where values clamp", "[mesher][levelset]") {
+TEST_CASE("level-set sign is right far from the surface, where values clamp", "[mesher][levelset][slow]") {
   const CadSolid solid = build_cad_solid(preset_recipe("SB"), false);
   const NeedleLevelSet level_set(solid.surface, LevelSetOptions{});
   std::mt19937 random(11);
@@ -67,7 +67,7 @@ TEST_CASE("level-set sign is right far from the surface, where values clamp", "[
   CHECK(checked > 2000);
 }
 
-TEST_CASE("particles inside a needle pushed into the block are the ones the ideal solid contains", "[mesher][levelset][particles]") {
+TEST_CASE("particles inside a needle pushed into the block are the ones the ideal solid contains", "[mesher][levelset][particles][slow]") {
   const CadSolid solid = build_cad_solid(preset_recipe("HMB"), false);
   const NeedleLevelSet level_set(solid.surface, LevelSetOptions{});
   LatticeOptions lattice;

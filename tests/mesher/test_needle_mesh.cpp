@@ -54,7 +54,7 @@ std::set<std::array<int, 3>> exposed_faces(const TetMesh& m) {
 
 }  // namespace
 
-TEST_CASE("T10 meshes of the paper presets match the ideal solid's volume and facet areas", "[mesher][gmsh]") {
+TEST_CASE("T10 meshes of the paper presets match the ideal solid's volume and facet areas", "[mesher][gmsh][slow]") {
   for (const std::string preset : {"SB", "LMB", "AMB", "HMB"}) {
     const TipGeometry tip = resolve_tip(preset_recipe(preset));
     const TetMesh mesh = mesh_of(preset, true, 2, 0.25);
@@ -79,7 +79,7 @@ TEST_CASE("T10 meshes of the paper presets match the ideal solid's volume and fa
   }
 }
 
-TEST_CASE("every boundary face of the mesh carries a tag, and only boundary faces do", "[mesher][gmsh]") {
+TEST_CASE("every boundary face of the mesh carries a tag, and only boundary faces do", "[mesher][gmsh][slow]") {
   for (const bool half : {true, false}) {
     const TetMesh mesh = mesh_of("LMB", half, 1, 0.3);
     std::set<std::array<int, 3>> tagged;
@@ -100,7 +100,7 @@ TEST_CASE("every boundary face of the mesh carries a tag, and only boundary face
   }
 }
 
-TEST_CASE("tets are positive and boundary faces point outward (divergence theorem)", "[mesher][gmsh]") {
+TEST_CASE("tets are positive and boundary faces point outward (divergence theorem)", "[mesher][gmsh][slow]") {
   const TetMesh mesh = mesh_of("HMB", true, 1, 0.3);
   double volume_from_faces = 0, volume_from_tets = 0;
   for (int t = 0; t < mesh.num_tets(); ++t) {
@@ -116,7 +116,7 @@ TEST_CASE("tets are positive and boundary faces point outward (divergence theore
   CHECK(volume_from_faces == Approx(volume_from_tets).epsilon(1e-10));
 }
 
-TEST_CASE("T10 nodes: shaft mid-edge nodes on the true cylinder, edge nodes in VTK order", "[mesher][gmsh]") {
+TEST_CASE("T10 nodes: shaft mid-edge nodes on the true cylinder, edge nodes in VTK order", "[mesher][gmsh][slow]") {
   const TipGeometry tip = resolve_tip(preset_recipe("SB"));
   const TetMesh mesh = mesh_of("SB", true, 2, 0.25);
   REQUIRE(mesh.order == 2);
@@ -150,7 +150,7 @@ TEST_CASE("T10 nodes: shaft mid-edge nodes on the true cylinder, edge nodes in V
   CHECK(worst_ratio < 0.25);
 }
 
-TEST_CASE("a mesh survives the .msh round trip with its tags, and .vtu is written whole", "[mesher][gmsh][io]") {
+TEST_CASE("a mesh survives the .msh round trip with its tags, and .vtu is written whole", "[mesher][gmsh][io][slow]") {
   const TetMesh mesh = mesh_of("AMB", true, 2, 0.3);
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / "needle-msh-test";
   std::filesystem::remove_all(dir);
@@ -186,7 +186,7 @@ TEST_CASE("a mesh survives the .msh round trip with its tags, and .vtu is writte
   std::filesystem::remove_all(dir);
 }
 
-TEST_CASE("mesh_surface fills a closed tagged surface and keeps its tags", "[mesher][gmsh]") {
+TEST_CASE("mesh_surface fills a closed tagged surface and keeps its tags", "[mesher][gmsh][slow]") {
   // A 2 x 1 x 1 mm box, two triangles per face, each face its own tag.
   TriSurface box;
   box.V.resize(8, 3);

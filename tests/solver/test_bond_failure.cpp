@@ -25,7 +25,7 @@ std::vector<int> components(const SpgTissue& tissue) {
 
 }  // namespace
 
-TEST_CASE("A notched bar pulled apart separates at the bond-failure strain", "[solver][failure]") {
+TEST_CASE("A notched bar pulled apart separates at the bond-failure strain", "[solver][failure][slow]") {
   // 12 x 3 x 2 mm bar, a notch of one particle plane removed over the lower half at x = 6.
   ParticleSet full = needle_test::free_box({0, -1.5, 0}, {12, 1.5, 2}, 0.5);
   std::vector<Eigen::Index> keep;

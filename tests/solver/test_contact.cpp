@@ -62,7 +62,7 @@ Eigen::Vector3d total(const NodalForces& f) {
 }  // namespace
 
 TEST_CASE("Contact law: a particle within the skin is pushed out by k g n, k the closed form, the needle takes the opposite force",
-          "[solver][contact][gmsh]") {
+          "[solver][contact][gmsh][slow]") {
   const TetMesh mesh = rod_mesh();
   const ContactSurface surface(mesh);
   TissueMaterial material;
@@ -103,7 +103,7 @@ TEST_CASE("Contact law: a particle within the skin is pushed out by k g n, k the
 }
 
 TEST_CASE("Contact law: a particle sliding over a facet feels Coulomb friction against its sliding, capped when slow, and the damper",
-          "[solver][contact][gmsh]") {
+          "[solver][contact][gmsh][slow]") {
   // The law of contact/needle_tissue_contact.h written out for one particle over the middle of one surface triangle,
   // in the contact's own normal n (the level set's at the particle's start), against a rigid needle at rest:
   //   g = skin - phi_start - dt n.v,  f_n = max(0, k g - c n.v),  c = zeta 2 sqrt(k m),
@@ -158,7 +158,7 @@ TEST_CASE("Contact law: a particle sliding over a facet feels Coulomb friction a
 }
 
 TEST_CASE("Contact surface: pull-back undoes a rigid motion of the needle, and the triangle under a point carries it by its weights",
-          "[solver][contact][gmsh]") {
+          "[solver][contact][gmsh][slow]") {
   const TetMesh mesh = rod_mesh();
   const ContactSurface surface(mesh);
   const Eigen::MatrixX3d& X = surface.reference_positions();

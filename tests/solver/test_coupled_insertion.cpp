@@ -85,7 +85,7 @@ ParticleSet block(double length_mm, double half_height_mm, double depth_mm, doub
 
 }  // namespace
 
-TEST_CASE("A rigid needle driven into tissue with fixed sides balances energy within 2 %", "[solver][lspg][gmsh]") {
+TEST_CASE("A rigid needle driven into tissue with fixed sides balances energy within 2 %", "[solver][lspg][gmsh][slow]") {
   const TetMesh mesh = small_needle(short_tip("SB", 6.0), true, 0.5);
   const InsertionProfile profile = quick_profile(2.0);
   Insertion ins(mesh, 0.0, true, profile, Eigen::Vector3d::UnitX(), block(3.0, 1.6, 1.2, 0.4, true), CouplingOptions{});
@@ -116,7 +116,7 @@ TEST_CASE("A rigid needle driven into tissue with fixed sides balances energy wi
   CHECK(cut.bonds_cut() == ins.tissue.bonds().cut_count);
 }
 
-TEST_CASE("A free tissue block hit by a driven needle conserves momentum within 2 %", "[solver][lspg][gmsh]") {
+TEST_CASE("A free tissue block hit by a driven needle conserves momentum within 2 %", "[solver][lspg][gmsh][slow]") {
   // Free faces: only the drive (and the z symmetry) acts from outside, so in x and y the momentum of
   // tissue plus needle changes by the drive's impulse. The flexible needle subcycles inside the tissue
   // steps, so this also checks the multi-rate exchange of momentum.
@@ -134,7 +134,7 @@ TEST_CASE("A free tissue block hit by a driven needle conserves momentum within 
   CHECK(ins.run.energy().balance_error() < 0.02);
 }
 
-TEST_CASE("A block pressed on a sliding needle face recovers the Coulomb coefficient", "[solver][lspg][gmsh]") {
+TEST_CASE("A block pressed on a sliding needle face recovers the Coulomb coefficient", "[solver][lspg][gmsh][slow]") {
   // A plain rod's flat end face (normal +x) slides along +y under a small block pressed onto it by a body
   // load along -x; the block's far face is held, so the face slides under it. While it slides, the
   // tangential force on the face over the normal force is mu.
@@ -177,7 +177,7 @@ TEST_CASE("A block pressed on a sliding needle face recovers the Coulomb coeffic
   CHECK(shear > 0);
 }
 
-TEST_CASE("The subcycled, mass-scaled needle matches the plain full model's tip deflection", "[solver][lspg][gmsh]") {
+TEST_CASE("The subcycled, mass-scaled needle matches the plain full model's tip deflection", "[solver][lspg][gmsh][slow]") {
   // SB tip, 16 mm modelled, T4: the full model steps everything at the steel's stable step; the fast one
   // subcycles the needle inside the tissue's step and mass-scales the tip. Stated tolerance: 5 % of the
   // full model's tip deflection at the default coupling step (contact_courant 0.1; the error is first
@@ -212,7 +212,7 @@ TEST_CASE("The subcycled, mass-scaled needle matches the plain full model's tip 
 }
 
 TEST_CASE("Particles inside the contact skin at the start do not trip the energy check while the drive's work is small",
-          "[solver][lspg][gmsh]") {
+          "[solver][lspg][gmsh][slow]") {
   // The paper's set-up puts tip point A on the block's entry face. With fine particles some start
   // within the contact's skin of the tip: the penalty holds energy at t = 0 and releases it in the
   // first steps, while the drive has done almost no work. Measured against the drive's nanojoules that
@@ -246,7 +246,7 @@ TEST_CASE("Particles inside the contact skin at the start do not trip the energy
   CHECK(e.balance_error() < 0.02);
 }
 
-TEST_CASE("A cutting pressure loads the tip facets along their normals and the balance books its work", "[solver][lspg][gmsh][cutting]") {
+TEST_CASE("A cutting pressure loads the tip facets along their normals and the balance books its work", "[solver][lspg][gmsh][cutting][slow]") {
   // The rigid SB tip driven 2 mm into the fixed-sides block, with and without a cutting pressure p_c.
   // Closed forms: on the (planar) top facet the resistance is -p_c A n_top, so its direction is the
   // facet's normal to rounding and its size at most p_c times the facet's exact area; over the run it
@@ -301,7 +301,7 @@ TEST_CASE("A cutting pressure loads the tip facets along their normals and the b
 }
 
 TEST_CASE("A needle turned upside down deflects the other way by as much: the coupled model has no up/down bias",
-          "[solver][lspg][gmsh][symmetry]") {
+          "[solver][lspg][gmsh][symmetry][slow]") {
   // SB without its groove, and its mirror image in the plane y = 0 (every facet's rotation phi -> 180 - phi,
   // tip point A from the rod's bottom to its top), each driven 2 mm into the fixed-sides block, whose
   // lattice is symmetric about the path. Mirror symmetry of the model demands delta_up = -delta_down.
@@ -348,7 +348,7 @@ ContactOptions projection() {
 }  // namespace
 
 TEST_CASE("Projection contact: a free block hit by the needle exchanges momentum exactly, at 5 times the penalty's step",
-          "[solver][lspg][gmsh]") {
+          "[solver][lspg][gmsh][slow]") {
   // Free faces: only the drive and the z symmetry act from outside. The needle receives each step's impulse
   // over the next step, so what it has not received yet (pending) closes the balance; the FE needle's first
   // half kick of a step (the implicit needle's first trapezoid) still uses the last step's force: half a needle
@@ -393,7 +393,7 @@ TEST_CASE("Projection contact: a free block hit by the needle exchanges momentum
 }
 
 TEST_CASE("Projection contact: a rigid needle into a block with fixed sides balances energy within 1 %, dissipation never negative",
-          "[solver][lspg][gmsh]") {
+          "[solver][lspg][gmsh][slow]") {
   const TetMesh mesh = small_needle(short_tip("SB", 6.0), true, 0.5);
   const InsertionProfile profile = quick_profile(2.0);
   Insertion ins(mesh, 0.0, true, profile, Eigen::Vector3d::UnitX(), block(3.0, 1.6, 1.2, 0.4, true), CouplingOptions{}, projection());
@@ -421,7 +421,7 @@ TEST_CASE("Projection contact: a rigid needle into a block with fixed sides bala
 }
 
 TEST_CASE("Tissue mass scaling: a needle into a block at 1.5 times the tissue's step, balance within 2 %, none inside",
-          "[solver][lspg][gmsh]") {
+          "[solver][lspg][gmsh][slow]") {
   // The fast level's third lever: particles whose own step falls below the target get mass. At 1.5 times the
   // tissue's first step every particle is scaled (about 2.25 times its mass), the squeezed ones more; the run
   // takes the target step throughout, keeps its energy account (the kinetic energy the mass changes remove is

@@ -60,7 +60,7 @@ double mean_tip_y(const NeedleModel& model, const std::vector<int>& nodes) {
 }  // namespace
 
 TEST_CASE("Implicit needle: a slowly ramped tip load ends at the clamped needle's static deflection within 1 %",
-          "[solver][needle][gmsh]") {
+          "[solver][needle][gmsh][slow]") {
   const FeNeedle fe(rod(), NeedleMaterial{}, 0.0);
   const NeedleSupports supports = driven_base_supports(fe.mesh(), held());
   const ClampedNeedle clamped(fe, supports.driven);
@@ -96,7 +96,7 @@ TEST_CASE("Implicit needle: a slowly ramped tip load ends at the clamped needle'
 }
 
 TEST_CASE("Implicit needle: a tip load applied at once swings as the explicit FE needle does, within 1 % of the swing",
-          "[solver][needle][gmsh]") {
+          "[solver][needle][gmsh][slow]") {
   const FeNeedle fe(rod(), NeedleMaterial{}, 0.0);
   const NeedleSupports supports = driven_base_supports(fe.mesh(), held());
   const double period_ms = 1e3 / ClampedNeedle(fe, supports.driven).lowest_modes(1).front().frequency_hz;
@@ -172,7 +172,7 @@ TEST_CASE("Implicit needle: driven at its base it moves with the drive and the d
 }
 
 TEST_CASE("Implicit needle: a rod pressed against the cannula's bore is held there as the explicit FE needle's cannula holds it",
-          "[solver][needle][gmsh]") {
+          "[solver][needle][gmsh][slow]") {
   // The base at x = -8 held, the cannula's front at x = -3 with 0.025 mm of clearance around the rod: a tip
   // load of 6 N, ramped over 10 periods and held, presses the rod's bottom line onto the bore at the front.
   const FeNeedle fe(rod(), NeedleMaterial{}, 0.0);

@@ -32,7 +32,7 @@ double depth_in_rod(const Eigen::Vector3d& p) {
 
 }  // namespace
 
-TEST_CASE("A segment across the rod meets its surface where the cylinder says", "[solver][bond_cut][gmsh]") {
+TEST_CASE("A segment across the rod meets its surface where the cylinder says", "[solver][bond_cut][gmsh][slow]") {
   for (bool half : {false, true}) {
     const TetMesh mesh = rod_mesh(half);
     const ContactSurface surface(mesh);
@@ -58,7 +58,7 @@ TEST_CASE("A segment across the rod meets its surface where the cylinder says", 
   }
 }
 
-TEST_CASE("The bonds through the rod are those whose segment dips into the cylinder", "[solver][bond_cut][gmsh]") {
+TEST_CASE("The bonds through the rod are those whose segment dips into the cylinder", "[solver][bond_cut][gmsh][slow]") {
   // A lattice through which the rod is pushed (its particles inside the rod removed, as a cut leaves
   // them): a bond is cut where its segment passes through the cylinder, checked by sampling each segment
   // against the closed form. Within the faceting's sag of the surface both answers are allowed.

@@ -119,7 +119,7 @@ TEST_CASE("Mirroring a half mesh gives an exactly symmetric, conforming full mes
   CHECK(interior < 1e-9 * f.cwiseAbs().maxCoeff());
 }
 
-TEST_CASE("A free rod pushed through the cannula by the paper's profile ends undeflected, energy balanced", "[solver][needle][gmsh]") {
+TEST_CASE("A free rod pushed through the cannula by the paper's profile ends undeflected, energy balanced", "[solver][needle][gmsh][slow]") {
   // A full rod mirrored from a half (so exactly symmetric in y: any deflection would be spurious),
   // T4, selective mass scaling to a 4e-5 ms step (adds ~15 % mass in the few smallest tets; the
   // deflection and the balance do not depend on it).
@@ -151,7 +151,7 @@ TEST_CASE("A free rod pushed through the cannula by the paper's profile ends und
   CHECK(run.energy().drive_work_mJ == Approx(0.5 * needle.nodal_mass_g().sum() * 64.0).epsilon(0.02));
 }
 
-TEST_CASE("A needle driven at an angle into the cannula wall is held by it", "[solver][needle][gmsh]") {
+TEST_CASE("A needle driven at an angle into the cannula wall is held by it", "[solver][needle][gmsh][slow]") {
   const FeNeedle needle(rod_mesh(20.0, 0.5, true, 1), NeedleMaterial{}, 4e-5);
   NeedleSupports supports = driven_base(needle, true);
   supports.direction = Eigen::Vector3d(std::cos(2.0 * M_PI / 180), std::sin(2.0 * M_PI / 180), 0.0);  // 2 degrees up
@@ -179,7 +179,7 @@ TEST_CASE("A needle driven at an angle into the cannula wall is held by it", "[s
   CHECK(run.energy().balance_error() < 0.005);
 }
 
-TEST_CASE("A released cantilever vibrates at the frequency of the modal analysis", "[solver][needle][gmsh]") {
+TEST_CASE("A released cantilever vibrates at the frequency of the modal analysis", "[solver][needle][gmsh][slow]") {
   // Same mesh and (scaled) masses for both, so the explicit integration is checked against the
   // eigen-solution of the same discrete system.
   const FeNeedle needle(rod_mesh(20.0, 0.4, false, 1), NeedleMaterial{}, 1e-4);

@@ -106,7 +106,7 @@ TEST_CASE("FE forces vanish under rigid motion of any size and conserve momentum
   }
 }
 
-TEST_CASE("Plain rod: tip compliance and first bending frequency within 2 % of Euler-Bernoulli", "[solver][needle][gmsh]") {
+TEST_CASE("Plain rod: tip compliance and first bending frequency within 2 % of Euler-Bernoulli", "[solver][needle][gmsh][slow]") {
   const NeedleMaterial steel;
   for (double length : {30.0, 40.0}) {
     const TipGeometry tip = plain_rod_tip(1.0, length);
@@ -127,7 +127,7 @@ TEST_CASE("Plain rod: tip compliance and first bending frequency within 2 % of E
   }
 }
 
-TEST_CASE("Grooved presets: tip compliance within 2 % of Euler-Bernoulli with the real sections", "[solver][needle][gmsh]") {
+TEST_CASE("Grooved presets: tip compliance within 2 % of Euler-Bernoulli with the real sections", "[solver][needle][gmsh][slow]") {
   // Free lengths 40 and 50 mm. The FE model is ~0.13 mm/N (y) more compliant than beam theory,
   // independent of length: the sudden section change at the groove's back end, where the neutral
   // axis jumps, is a 3D effect beam theory does not have (docs/solver.md). At 30 mm that is 2.0-2.1 %.

@@ -73,7 +73,7 @@ TEST_CASE("A longitudinal pulse travels along a bar at sqrt(E / rho)", "[solver]
   CHECK(std::abs(measured / c - 1) < 0.02);
 }
 
-TEST_CASE("An undamped elastic vibration keeps its energy over ten periods", "[solver][dynamics]") {
+TEST_CASE("An undamped elastic vibration keeps its energy over ten periods", "[solver][dynamics][slow]") {
   const TissueMaterial card = bar_card(0.3);
   const double L = 20.0, c = std::sqrt(card.E_MPa / card.density_g_per_mm3());
   SpgTissue tissue(needle_test::free_box({0, 0, 0}, {L, 2, 2}, 0.5), card, SpgOptions{});
@@ -148,7 +148,7 @@ TEST_CASE("The odd-even mode costs no energy under nodal integration; smoothing 
   CHECK(filter_ratio < 0.95);
 }
 
-TEST_CASE("A viscoelastic bar's vibration decays at the closed-form loss factor, and the energy balance books it", "[solver][dynamics][viscoelastic]") {
+TEST_CASE("A viscoelastic bar's vibration decays at the closed-form loss factor, and the energy balance books it", "[solver][dynamics][viscoelastic][slow]") {
   // The vibrating bar above, with a tenth of the shear stress relaxing at tau = 1 / omega, where the
   // branch's loss is largest (so the SPG bar's slightly different frequency hardly changes it). Complex
   // shear modulus G* = G (1 - g + g i w tau / (1 + i w tau)); the thin bar's modulus E* = 9 K G* / (3 K + G*);

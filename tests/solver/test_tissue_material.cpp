@@ -101,7 +101,7 @@ TEST_CASE("The effective strain of an isochoric stretch is its log stretch, thro
   CHECK(state.plastic_strain > 0.1);  // the card hardens steeply: 0.21 of the 1.5
 }
 
-TEST_CASE("Uniaxial tension of a particle specimen follows the closed-form MAT_018 curve to strain 1.5", "[solver][material][uniaxial]") {
+TEST_CASE("Uniaxial tension of a particle specimen follows the closed-form MAT_018 curve to strain 1.5", "[solver][material][uniaxial][slow]") {
   struct Card {
     double E, k, n, nu;
   };
@@ -125,7 +125,7 @@ TEST_CASE("Uniaxial tension of a particle specimen follows the closed-form MAT_0
   }
 }
 
-TEST_CASE("The rate law stiffens the specimen by the Cowper-Symonds factor at the imposed rate", "[solver][material][uniaxial]") {
+TEST_CASE("The rate law stiffens the specimen by the Cowper-Symonds factor at the imposed rate", "[solver][material][uniaxial][slow]") {
   TissueMaterial m;
   m.E_MPa = 0.1;  // yields at strain 0.49 (0.95 with the rate factor), plastic beyond
   UniaxialTestOptions options;
@@ -191,7 +191,7 @@ TEST_CASE("The stiffening law's tangent wave modulus is the derivative of its eq
   CHECK_THROWS_WITH(tissue_law_from_name("neo_hookean"), Catch::Contains("mat018, stiffening_elastic"));
 }
 
-TEST_CASE("Uniaxial tension of a particle specimen follows the stiffening law's closed-form curve", "[solver][material][uniaxial]") {
+TEST_CASE("Uniaxial tension of a particle specimen follows the stiffening law's closed-form curve", "[solver][material][uniaxial][slow]") {
   // The closed form solves the lateral contraction of the scalar law by bisection; the specimen
   // integrates the tensor update with the servo holding the lateral stress at zero.
   TissueMaterial m;

@@ -62,7 +62,7 @@ std::string read_text(const fs::path& path) {
 
 }  // namespace
 
-TEST_CASE("needle paper --report-only: runs matching the experiment meet every target", "[apps][paper]") {
+TEST_CASE("needle paper --report-only: runs matching the experiment meet every target", "[apps][paper][slow]") {
   const fs::path dir = fresh("match");
   // The experiment's deflections, off by at most 0.05 mm; groove fills in the paper's order.
   const std::map<std::string, FakeRun> runs = {
@@ -122,7 +122,7 @@ TEST_CASE("needle paper --report-only: runs matching the experiment meet every t
         std::string::npos);
 }
 
-TEST_CASE("needle paper --report-only: a wrong sign, a large error and a wrong groove ranking are reported as not met", "[apps][paper]") {
+TEST_CASE("needle paper --report-only: a wrong sign, a large error and a wrong groove ranking are reported as not met", "[apps][paper][slow]") {
   const fs::path dir = fresh("miss");
   write_run(dir, "SB", {+0.30, 0.2});   // wrong sign, 1.44 mm off
   write_run(dir, "LMB", {0.16, 0.9});
@@ -145,7 +145,7 @@ TEST_CASE("needle paper --report-only: a wrong sign, a large error and a wrong g
 
 TEST_CASE("needle paper --report-only names the tissue law, the relaxation, the block, the slit, the crack, the contact, the cutting pressure, the entry face, the drive speed and the groove's start when they "
           "are not the paper's model",
-          "[apps][paper]") {
+          "[apps][paper][slow]") {
   const fs::path dir = fresh("law");
   for (const char* name : {"SB", "LMB", "AMB", "HMB"}) {
     write_run(dir, name, {-1.1, 0.9});
@@ -183,7 +183,7 @@ TEST_CASE("needle paper --report-only names the tissue law, the relaxation, the 
   CHECK(tissue.find("driven at 4 m/s") != std::string::npos);
 }
 
-TEST_CASE("needle paper --report-only takes E from the runs it reports, and refuses a flag that names another", "[apps][paper]") {
+TEST_CASE("needle paper --report-only takes E from the runs it reports, and refuses a flag that names another", "[apps][paper][slow]") {
   // Runs made at E 0.0748 MPa (e.g. with --tissue-E-MPa): the report must say their E, not the card's default.
   auto write_runs_at = [](const fs::path& dir, double lmb_E_MPa) {
     for (const char* name : {"SB", "LMB", "AMB", "HMB"}) {
@@ -216,7 +216,7 @@ TEST_CASE("needle paper --report-only takes E from the runs it reports, and refu
   CHECK(!fs::exists(mixed / "report.md"));
 }
 
-TEST_CASE("needle paper refuses missing runs and unknown needles with one message and exit 2", "[apps][paper]") {
+TEST_CASE("needle paper refuses missing runs and unknown needles with one message and exit 2", "[apps][paper][slow]") {
   const fs::path dir = fresh("bad");
   auto r = run("paper --report-only --no-tips --out " + dir.string(), true);
   CHECK(r.exit_code == 2);
@@ -231,7 +231,7 @@ TEST_CASE("needle paper refuses missing runs and unknown needles with one messag
 }
 
 TEST_CASE("needle paper --compare sets another model's results beside this one, with delta / delta_SB and the targets each meets",
-          "[apps][paper]") {
+          "[apps][paper][slow]") {
   const fs::path other = fresh("compare_other"), dir = fresh("compare_this");
   // Another model: SB 0.84 mm off, LMB near the experiment, AMB too low (LMB > AMB + 0.1: the order
   // fails), HMB 1.21 mm off, the groove ranking wrong: 1 of 6 targets.
@@ -285,7 +285,7 @@ TEST_CASE("Compared models get colours of their own, never the experiment's or L
 }
 
 TEST_CASE("needle paper --replica gives each deflection's spread over replicas of the same model and the targets that hold in each",
-          "[apps][paper]") {
+          "[apps][paper][slow]") {
   // This report meets LMB's target by 0.07 mm. Replica A (SB and LMB, e.g. the lattice shifted) puts LMB 0.17 mm off and above
   // AMB + 0.1 (the order fails); replica B (LMB alone) meets it. Spreads: SB |-1.10 - -1.12| = 0.02, LMB 0.32 - 0.18 = 0.14.
   const fs::path dir = fresh("replica_this"), a = fresh("replica_a"), b = fresh("replica_b");
@@ -344,7 +344,7 @@ TEST_CASE("needle paper --replica gives each deflection's spread over replicas o
 }
 
 TEST_CASE("needle paper says why a deflection target is missed: margin against scatter, the load behind it, the ratio no E fixes",
-          "[apps][paper]") {
+          "[apps][paper][slow]") {
   // AMB 0.76 mm high with the shaft pushed up 0.3 N at the end; every other needle within its target.
   // delta_AMB / delta_SB = 1.0 / -1.14 = -0.877 against the experiment's 0.24 / -1.14 = -0.211: at SB's measured delta the
   // ratio leaves AMB (-0.877 + 0.211) * -1.14 = +0.760 mm off.

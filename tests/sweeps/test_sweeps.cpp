@@ -126,7 +126,7 @@ TEST_CASE("The deflection's zero crossings lie on the straight line between the 
   CHECK(without[0].value == Approx(-0.2 + 0.4 * 0.10 / 0.50));
 }
 
-TEST_CASE("needle sweep gives one table on worker processes, on MPI ranks and as a batch array", "[sweeps][gmsh][lspg]") {
+TEST_CASE("needle sweep gives one table on worker processes, on MPI ranks and as a batch array", "[sweeps][gmsh][lspg][slow]") {
   const fs::path dir = fresh_folder("sweep_workers");
   write_tiny_sweep(dir);
   const std::string sweep = (dir / "sweep.json").string();
@@ -191,7 +191,7 @@ TEST_CASE("needle sweep gives one table on worker processes, on MPI ranks and as
   CHECK(!fs::exists(dir / "nothing"));
 }
 
-TEST_CASE("A sweep interrupted midway loses no finished case and repeats none when started again", "[sweeps][gmsh][lspg]") {
+TEST_CASE("A sweep interrupted midway loses no finished case and repeats none when started again", "[sweeps][gmsh][lspg][slow]") {
   const fs::path dir = fresh_folder("sweep_resume");
   write_tiny_scene(dir);
   write(dir / "sweep.json", R"({"base": {"scene": "scene.json"}, "model": "fast", "variables": {"tissue.friction": {"from": 0.05, "to": 0.4, "count": 8}}})");
@@ -236,7 +236,7 @@ TEST_CASE("A sweep interrupted midway loses no finished case and repeats none wh
   CHECK(other.out.find("holds another study") != std::string::npos);
 }
 
-TEST_CASE("Bad sweep and optimisation files get one clear error before any case runs", "[sweeps]") {
+TEST_CASE("Bad sweep and optimisation files get one clear error before any case runs", "[sweeps][slow]") {
   const fs::path dir = fresh_folder("sweep_bad");
   write_tiny_scene(dir);
   const std::vector<std::pair<std::string, std::string>> sweeps = {
@@ -378,7 +378,7 @@ TEST_CASE("Explicit cases set only their own variables and keep their labels", "
 }
 
 TEST_CASE("needle stress runs the short hard-case suite: each case finished with finite numbers or stopped by a monitor",
-          "[sweeps][gmsh][lspg]") {
+          "[sweeps][gmsh][lspg][slow]") {
   const fs::path dir = fresh_folder("stress");
   const Result r = run("stress --short --out " + (dir / "out").string(), true);
   INFO(r.out);
