@@ -19,6 +19,7 @@ PACKAGES=(
   libsuitesparse-dev libspectra-dev
   libnlopt-dev libnlopt-cxx-dev libopenmpi-dev openmpi-bin
   python3-meshio python3-vtk9
+  paraview python3-paraview xvfb xauth
 )
 if [ "${1:-}" = "--checking" ]; then PACKAGES+=(clang libclang-rt-14-dev); fi
 missing=()
