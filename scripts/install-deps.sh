@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Installs every build and test dependency of the project from Debian's packages.
+# Installs every build and test dependency of the project from Debian's packages. The tests' VTK is ParaView's
+# (python3-paraview: pvpython and Python's vtk module); Debian's python3-vtk9 conflicts with it.
 # --checking also installs what the checking build needs (scripts/test-sanitizers.sh): clang with its sanitizer
 # and libFuzzer runtimes.
 # Safe to run again: apt-get skips what is already there.
@@ -18,8 +19,8 @@ PACKAGES=(
   libpng-dev libfreetype-dev fonts-dejavu-core
   libsuitesparse-dev libspectra-dev
   libnlopt-dev libnlopt-cxx-dev libopenmpi-dev openmpi-bin
-  python3-meshio python3-vtk9
-  paraview python3-paraview xvfb xauth
+  python3-meshio
+  python3-paraview xvfb xauth
 )
 if [ "${1:-}" = "--checking" ]; then PACKAGES+=(clang libclang-rt-14-dev); fi
 missing=()

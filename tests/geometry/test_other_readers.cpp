@@ -1,4 +1,4 @@
-// Other projects' readers open what the toolkit writes: meshio (python3-meshio) and VTK (python3-vtk9) read the
+// Other projects' readers open what the toolkit writes: meshio (python3-meshio) and VTK (ParaView's, python3-paraview) read the
 // exported surfaces (STL binary and ASCII, OBJ, PLY) with our triangles and area, gmsh reads the STL files, and VTK
 // reads the T10 mesh (VTU) and the particle set (VTP) with their counts.
 #include <catch2/catch.hpp>
@@ -27,7 +27,7 @@ fs::path fresh_dir(const std::string& name) {
   return dir;
 }
 
-// Runs a Python script with Debian's python3 (where python3-meshio and python3-vtk9 live); its output.
+// Runs a Python script with Debian's python3 (where python3-meshio and ParaView's vtk module live); its output.
 std::string run_python(const fs::path& dir, const std::string& script) {
   std::ofstream(dir / "read.py") << script;
   FILE* pipe = popen(("/usr/bin/python3 " + (dir / "read.py").string() + " 2>&1").c_str(), "r");

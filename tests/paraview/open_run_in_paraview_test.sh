@@ -15,8 +15,17 @@ dir="$(mktemp -d)"
 trap 'rm -rf "$dir"' EXIT
 script="$source_dir/scripts/open_run_in_paraview.py"
 "$needle" simulate "$source_dir/data/scenes/regression/sb.json" --out "$dir/run" --quiet
-# A virtual X server can fail to come up when another starts at the same moment: one more try.
-paraview() { xvfb-run -a -s "-screen 0 1920x1080x24" pvpython "$@" || { sleep 2; xvfb-run -a -s "-screen 0 1920x1080x24" pvpython "$@"; }; }
+# pvpython under a virtual X server. On a loaded machine its first connection to a fresh Xvfb now and then fails
+# ("bad X server connection", in a second and before anything is written): up to five tries.
+paraview() {
+  local try
+  for try in 1 2 3 4 5; do
+    if xvfb-run -a -s "-screen 0 1920x1080x24" pvpython "$@"; then return 0; fi
+    echo "pvpython under xvfb-run failed (try $try of 5)"
+    sleep 2
+  done
+  return 1
+}
 paraview "$script" "$dir/run" --screenshot "$dir/run.png" --state "$dir/run.pvsm" --size 1200x700
 cat > "$dir/check.py" << PY
 import vtk
