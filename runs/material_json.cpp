@@ -34,7 +34,7 @@ TissueMaterial read_material_file(const std::string& path) {
   nlohmann::json json;
   try {
     json = parse_json_refusing_duplicates(in, path);
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {  // a parse error, or a number too large (out_of_range)
     throw InputError(fmt::format("{}: not valid JSON ({})", path, json_error_words(e)));
   }
   return material_from_json(json, path);

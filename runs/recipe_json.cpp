@@ -93,7 +93,7 @@ GrindingRecipe read_recipe_file(const std::string& path) {
   json root;
   try {
     root = parse_json_refusing_duplicates(in, path);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // a parse error, or a number too large (out_of_range)
     throw InputError(fmt::format("{}: not valid JSON: {}", path, json_error_words(e)));
   }
   return recipe_from_json(root, path);
