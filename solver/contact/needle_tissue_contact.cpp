@@ -48,29 +48,44 @@ void NeedleTissueContact::build_node_grid(const Eigen::MatrixX3d& x) {
     box_hi_ = box_hi_.cwiseMax(x.row(n).transpose());
   }
   node_origin_ = box_lo_.array() - 2 * node_cell_mm_;
-  node_cells_.clear();
-  for (int n : nodes) {
-    const Eigen::Vector3i c = ((x.row(n).transpose() - node_origin_) / node_cell_mm_).array().floor().cast<int>();
-    node_cells_.emplace_back((static_cast<long>(c.x()) << 42) | (static_cast<long>(c.y()) << 21) | c.z(), n);
+  // A dense grid (the needle's box and two cells around it), each cell's nodes in increasing order: a counting
+  // sort over the nodes, which the search then reads cell by cell.
+  std::vector<int> cell(nodes.size());
+  node_grid_dims_ = Eigen::Vector3i::Zero();
+  for (size_t k = 0; k < nodes.size(); ++k) {
+    const Eigen::Vector3i c = ((x.row(nodes[k]).transpose() - node_origin_) / node_cell_mm_).array().floor().cast<int>();
+    node_grid_dims_ = node_grid_dims_.cwiseMax(c + Eigen::Vector3i::Constant(3));
   }
-  std::sort(node_cells_.begin(), node_cells_.end());
+  const auto index = [this](const Eigen::Vector3i& c) { return (c.z() * node_grid_dims_.y() + c.y()) * node_grid_dims_.x() + c.x(); };
+  node_cell_start_.assign(static_cast<size_t>(node_grid_dims_.prod()) + 1, 0);
+  std::vector<int> order(nodes.begin(), nodes.end());
+  std::sort(order.begin(), order.end());
+  for (size_t k = 0; k < order.size(); ++k) {
+    cell[k] = index(((x.row(order[k]).transpose() - node_origin_) / node_cell_mm_).array().floor().cast<int>());
+    ++node_cell_start_[static_cast<size_t>(cell[k]) + 1];
+  }
+  for (size_t c = 1; c < node_cell_start_.size(); ++c) node_cell_start_[c] += node_cell_start_[c - 1];
+  node_cell_nodes_.resize(order.size());
+  std::vector<int> fill(node_cell_start_.begin(), node_cell_start_.end() - 1);
+  for (size_t k = 0; k < order.size(); ++k) node_cell_nodes_[static_cast<size_t>(fill[static_cast<size_t>(cell[k])]++)] = order[k];
 }
 
 int NeedleTissueContact::nearest_surface_node(const Eigen::Vector3d& p, const Eigen::MatrixX3d& x) const {
   const Eigen::Vector3i c = ((p - node_origin_) / node_cell_mm_).array().floor().cast<int>();
   int best = -1;
   double best_d2 = node_cell_mm_ * node_cell_mm_;
+  // Cells in x-major order, each cell's nodes in increasing order: of equally near nodes the first wins.
   for (int i = c.x() - 1; i <= c.x() + 1; ++i)
     for (int j = c.y() - 1; j <= c.y() + 1; ++j)
       for (int k = c.z() - 1; k <= c.z() + 1; ++k) {
-        if (i < 0 || j < 0 || k < 0) continue;
-        const long key = (static_cast<long>(i) << 42) | (static_cast<long>(j) << 21) | k;
-        auto it = std::lower_bound(node_cells_.begin(), node_cells_.end(), std::make_pair(key, -1));
-        for (; it != node_cells_.end() && it->first == key; ++it) {
-          const double d2 = (x.row(it->second).transpose() - p).squaredNorm();
+        if (i < 0 || j < 0 || k < 0 || i >= node_grid_dims_.x() || j >= node_grid_dims_.y() || k >= node_grid_dims_.z()) continue;
+        const size_t id = static_cast<size_t>((k * node_grid_dims_.y() + j) * node_grid_dims_.x() + i);
+        for (int e = node_cell_start_[id]; e < node_cell_start_[id + 1]; ++e) {
+          const int node = node_cell_nodes_[static_cast<size_t>(e)];
+          const double d2 = (x.row(node).transpose() - p).squaredNorm();
           if (d2 < best_d2) {
             best_d2 = d2;
-            best = it->second;
+            best = node;
           }
         }
       }

@@ -149,10 +149,12 @@ class NeedleTissueContact : public NeedleLoads {
   void build_node_grid(const Eigen::MatrixX3d& needle_x);
   int nearest_surface_node(const Eigen::Vector3d& p, const Eigen::MatrixX3d& needle_x) const;
 
-  // Grid of the current surface nodes (rebuilt per query): sorted (cell, node).
+  // Grid of the current surface nodes (rebuilt when the needle moves): cells of node_cell_mm_ from node_origin_.
   double node_cell_mm_ = 0;
   Eigen::Vector3d node_origin_ = Eigen::Vector3d::Zero();
-  std::vector<std::pair<long, int>> node_cells_;
+  Eigen::Vector3i node_grid_dims_ = Eigen::Vector3i::Zero();
+  std::vector<int> node_cell_start_;  // cell c's surface nodes: node_cell_nodes_[start[c] .. start[c + 1])
+  std::vector<int> node_cell_nodes_;
   Eigen::Vector3d box_lo_ = Eigen::Vector3d::Zero(), box_hi_ = Eigen::Vector3d::Zero();
 };
 

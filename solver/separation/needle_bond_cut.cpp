@@ -4,6 +4,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <nlohmann/json.hpp>
 
 namespace needle {
@@ -130,15 +131,15 @@ NeedleBondCut::Grid NeedleBondCut::build_grid(const Eigen::MatrixX3d& needle_x) 
   return grid;
 }
 
-std::vector<double> NeedleBondCut::crossings(const Grid& grid, const Eigen::Vector3d& a, const Eigen::Vector3d& b) const {
-  std::vector<double> s;
+template <class Visit>
+void NeedleBondCut::for_each_hit(const Grid& grid, const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Visit& visit) const {
   const Eigen::Vector3d lo = a.cwiseMin(b), hi = a.cwiseMax(b);
-  if ((hi.array() < grid.lo.array()).any() || (lo.array() > grid.hi.array()).any()) return s;
+  if ((hi.array() < grid.lo.array()).any() || (lo.array() > grid.hi.array()).any()) return;
   const Eigen::Vector3i c0 = grid.cell_of(lo), c1 = grid.cell_of(hi);
   // A segment within two cells along each axis (most bonds) lies in the cells around its lowest one: with no
   // triangle there, no crossing, and the cells are not walked. (Cells are clamped to the grid, which only
   // widens what is looked at.)
-  if ((c1 - c0).maxCoeff() <= 1 && !grid.near[static_cast<size_t>(grid.index(c0.x(), c0.y(), c0.z()))]) return s;
+  if ((c1 - c0).maxCoeff() <= 1 && !grid.near[static_cast<size_t>(grid.index(c0.x(), c0.y(), c0.z()))]) return;
   const Eigen::Vector3d d = b - a;
   const double length = d.norm();
   for (int i = c0.x(); i <= c1.x(); ++i)
@@ -149,12 +150,34 @@ std::vector<double> NeedleBondCut::crossings(const Grid& grid, const Eigen::Vect
           const Grid::Triangle& t = grid.triangles[static_cast<size_t>(grid.entries[static_cast<size_t>(e)])];
           if ((hi.array() < t.lo.array()).any() || (lo.array() > t.hi.array()).any()) continue;  // boxes apart: no hit
           const double hit = segment_triangle(a, d, length, t);
-          if (!std::isnan(hit)) s.push_back(hit);
+          if (!std::isnan(hit) && !visit(hit)) return;
         }
       }
+}
+
+std::vector<double> NeedleBondCut::crossings(const Grid& grid, const Eigen::Vector3d& a, const Eigen::Vector3d& b) const {
+  std::vector<double> s;
+  for_each_hit(grid, a, b, [&s](double hit) {
+    s.push_back(hit);
+    return true;
+  });
   std::sort(s.begin(), s.end());
   s.erase(std::unique(s.begin(), s.end(), [](double x, double y) { return y - x < kDistinctCrossing; }), s.end());
   return s;
+}
+
+bool NeedleBondCut::passes_through(const Grid& grid, const Eigen::Vector3d& a, const Eigen::Vector3d& b) const {
+  // crossings() merges each hit into the last one it kept when they are closer than kDistinctCrossing, so it
+  // finds two distinct points exactly when its highest and lowest hits lie that far apart: the walk stops there.
+  double lowest = std::numeric_limits<double>::infinity(), highest = -lowest;
+  bool two = false;
+  for_each_hit(grid, a, b, [&](double hit) {
+    lowest = std::min(lowest, hit);
+    highest = std::max(highest, hit);
+    two = highest - lowest >= kDistinctCrossing;
+    return !two;
+  });
+  return two;
 }
 
 std::vector<double> NeedleBondCut::surface_crossings(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
@@ -166,7 +189,7 @@ std::vector<std::int64_t> NeedleBondCut::bonds_through_needle(const BondNetwork&
                                                               const Eigen::MatrixX3d& needle_x) const {
   const Grid grid = build_grid(needle_x);
   return select_intact_bonds(bonds, [&](std::int32_t i, std::int32_t j) {
-    return crossings(grid, x[static_cast<size_t>(i)], x[static_cast<size_t>(j)]).size() >= 2;
+    return passes_through(grid, x[static_cast<size_t>(i)], x[static_cast<size_t>(j)]);
   });
 }
 

@@ -48,7 +48,12 @@ class NeedleBondCut : public SeparationModel {
  private:
   struct Grid;
   Grid build_grid(const Eigen::MatrixX3d& needle_x) const;
+  // Calls visit(s) for each hit of the segment a-b with a triangle, in no particular order, until visit returns false.
+  template <class Visit>
+  void for_each_hit(const Grid& grid, const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Visit& visit) const;
   std::vector<double> crossings(const Grid& grid, const Eigen::Vector3d& a, const Eigen::Vector3d& b) const;
+  // Whether crossings() would find at least two distinct points, without collecting them.
+  bool passes_through(const Grid& grid, const Eigen::Vector3d& a, const Eigen::Vector3d& b) const;
 
   const ContactSurface& surface_;
   std::int64_t cut_ = 0;
