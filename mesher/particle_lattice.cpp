@@ -115,6 +115,7 @@ ParticleSet make_particle_lattice(const TissueBox& box, const LatticeOptions& op
   p.x_mm.resize(n, 3);
   p.volume_mm3.resize(n);
   p.spacing_mm.resize(n);
+  p.axis_spacing_mm.resize(n, 3);
   p.flags.resize(n);
   Eigen::Index i = 0;
   for (Eigen::Index a = 0; a < nx; ++a)
@@ -123,6 +124,7 @@ ParticleSet make_particle_lattice(const TissueBox& box, const LatticeOptions& op
         p.x_mm.row(i) << nodes[0][a], nodes[1][b], nodes[2][c];
         p.volume_mm3[i] = dual[0][a] * dual[1][b] * dual[2][c];
         p.spacing_mm[i] = std::max({spacing[0][a], spacing[1][b], spacing[2][c]});
+        p.axis_spacing_mm.row(i) << spacing[0][a], spacing[1][b], spacing[2][c];
         std::uint8_t flags = 0;
         const Eigen::Index index[3] = {a, b, c}, last[3] = {nx - 1, ny - 1, nz - 1};
         for (int k = 0; k < 3; ++k) {

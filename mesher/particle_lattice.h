@@ -45,7 +45,9 @@ struct LatticeOptions {
 struct ParticleSet {
   Eigen::MatrixX3d x_mm;                                // #P by 3 positions
   Eigen::VectorXd volume_mm3;                           // #P dual-cell volumes
-  Eigen::VectorXd spacing_mm;                           // #P largest neighbouring interval (sets the support)
+  Eigen::VectorXd spacing_mm;                           // #P largest neighbouring interval (sets a spherical support)
+  Eigen::MatrixX3d axis_spacing_mm;                     // #P by 3: the largest neighbouring interval along each axis
+                                                        // (sets an ellipsoidal support; may be empty for other sets)
   Eigen::Matrix<std::uint8_t, Eigen::Dynamic, 1> flags;  // #P ParticleFlag bits
   Eigen::Vector3i nodes_per_axis{0, 0, 0};
   int num_particles() const { return static_cast<int>(x_mm.rows()); }

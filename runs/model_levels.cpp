@@ -8,10 +8,12 @@ namespace needle {
 
 const std::vector<ModelLevel>& model_levels() {
   static const std::vector<ModelLevel> levels = {
-      {"full", "fe", "penalty", false, "explicit FE needle subcycled in the tissue's step, frictional penalty contact (the reference)"},
-      {"projection", "fe", "projection", false, "explicit FE needle, kinematic contact: the tissue's own step"},
-      {"fast", "implicit", "projection", true,
-       "implicit linear needle at the coupling step, kinematic contact, tissue mass-scaled to the needle's step: no subcycling"},
+      {"full", "fe", "penalty", false, SupportShape::sphere,
+       "explicit FE needle subcycled in the tissue's step, frictional penalty contact (the reference)"},
+      {"projection", "fe", "projection", false, SupportShape::sphere, "explicit FE needle, kinematic contact: the tissue's own step"},
+      {"fast", "implicit", "projection", true, SupportShape::ellipsoid,
+       "implicit linear needle at the coupling step, kinematic contact, tissue mass-scaled to the needle's step: no subcycling; "
+       "ellipsoidal kernel supports on the graded lattice"},
   };
   return levels;
 }
@@ -23,6 +25,7 @@ void apply_model_level(Scene& scene, const std::string& name, const std::string&
       scene.needle.model = level.needle_model;
       scene.tissue.contact.law = level.contact_law;
       scene.solver.tissue_mass_scaling = level.tissue_mass_scaling;
+      scene.tissue.spg.support = level.support;
       if (!level.tissue_mass_scaling) scene.solver.tissue_mass_scaling_dt_ms = 0;
       return;
     }
@@ -34,7 +37,8 @@ void apply_model_level(Scene& scene, const std::string& name, const std::string&
 std::string model_level_of(const Scene& scene) {
   for (const ModelLevel& level : model_levels())
     if (scene.needle.model == level.needle_model && scene.tissue.contact.law == level.contact_law &&
-        (scene.solver.tissue_mass_scaling || scene.solver.tissue_mass_scaling_dt_ms > 0) == level.tissue_mass_scaling)
+        (scene.solver.tissue_mass_scaling || scene.solver.tissue_mass_scaling_dt_ms > 0) == level.tissue_mass_scaling &&
+        scene.tissue.spg.support == level.support)
       return level.name;
   return "custom";
 }

@@ -4,9 +4,11 @@
 //   full        the FE needle (explicit, subcycled) and the penalty contact: the reference, the paper's kind of model;
 //   projection  the FE needle and the kinematic contact: the contact no longer sets the step (one lever);
 //   fast        the implicit needle, the kinematic contact and the tissue mass-scaled to the needle's step: no
-//               subcycling, and the few particles squeezed under the tip no longer set everybody's step.
-// Each level sets needle.model, tissue.contact.law and solver.tissue_mass_scaling; every other key stays the
-// scene's. (The implicit needle needs the kinematic contact: a penalty's force changes within a needle step.)
+//               subcycling, and the few particles squeezed under the tip no longer set everybody's step; and
+//               ellipsoidal kernel supports, so the graded lattice's coarse particles reach as many neighbours as
+//               the fine ones (solver/tissue/kernel_supports.h).
+// Each level sets needle.model, tissue.contact.law, solver.tissue_mass_scaling and tissue.spg.support; every other
+// key stays the scene's. (The implicit needle needs the kinematic contact: a penalty's force changes within a needle step.)
 #include <string>
 #include <vector>
 
@@ -17,6 +19,7 @@ namespace needle {
 struct ModelLevel {
   std::string name, needle_model, contact_law;
   bool tissue_mass_scaling = false;
+  SupportShape support = SupportShape::sphere;
   std::string description;
 };
 

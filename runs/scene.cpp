@@ -124,6 +124,7 @@ void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc) {
         throw InputError(fmt::format("{}: {}", g.where(key), e.what()));
       }
     };
+    t.spg.support = name("support", support_shape_name(t.spg.support), support_shape_from_name);
     t.spg.kernel_update = name("kernel_update", kernel_update_name(t.spg.kernel_update), kernel_update_from_name);
     t.spg.kernel_update_interval_steps = g.integer("kernel_update_interval_steps", t.spg.kernel_update_interval_steps, 1, 1000000);
     t.spg.stabilization = name("stabilization", stabilization_name(t.spg.stabilization), stabilization_from_name);
@@ -230,7 +231,8 @@ json scene_to_json(const Scene& s) {
       {"enabled", t.enabled}, {"size_mm", vector_json(t.size_mm)}, {"entry_x_mm", t.entry_x_mm}, {"spacing_mm", t.spacing_mm},
       {"path_refinement", t.path_refinement}, {"path_half_width_mm", t.path_half_width_mm},
       {"dilation", t.dilation}, {"friction", t.friction}, {"material", material_to_json(t.material)},
-      {"spg", {{"kernel_update", kernel_update_name(t.spg.kernel_update)},
+      {"spg", {{"support", support_shape_name(t.spg.support)},
+               {"kernel_update", kernel_update_name(t.spg.kernel_update)},
                {"kernel_update_interval_steps", t.spg.kernel_update_interval_steps},
                {"stabilization", stabilization_name(t.spg.stabilization)},
                {"stabilization_coefficient", t.spg.stabilization_coefficient},

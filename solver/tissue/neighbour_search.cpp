@@ -10,13 +10,14 @@
 namespace needle {
 
 NeighbourLists find_covering_centres(const Eigen::MatrixX3d& points, const Eigen::MatrixX3d& centres,
-                                     const Eigen::VectorXd& radius_mm) {
+                                     const KernelSupports& supports) {
   const std::int64_t num_centres = centres.rows(), num_points = points.rows();
   NeighbourLists lists;
   lists.offset.assign(static_cast<size_t>(num_points + 1), 0);
   if (num_points == 0) return lists;
   NEEDLE_REQUIRE(num_centres > 0, "no particles to search");
-  const double cell = radius_mm.maxCoeff();
+  NEEDLE_REQUIRE(supports.size() == num_centres, "one kernel support per particle");
+  const double cell = supports.largest_mm();
   NEEDLE_REQUIRE(cell > 0 && std::isfinite(cell), "support radius must be a positive length");
   const Eigen::RowVector3d lo = centres.colwise().minCoeff();
   const Eigen::RowVector3d span = centres.colwise().maxCoeff() - lo;
@@ -58,7 +59,7 @@ NeighbourLists find_covering_centres(const Eigen::MatrixX3d& points, const Eigen
             const std::int64_t id = (static_cast<std::int64_t>(q[2]) * dims[1] + q[1]) * dims[0] + q[0];
             for (std::int64_t s = cell_start[static_cast<size_t>(id)]; s < cell_start[static_cast<size_t>(id + 1)]; ++s) {
               const std::int32_t j = sorted[static_cast<size_t>(s)];
-              if ((centres.row(j) - p).squaredNorm() < radius_mm[j] * radius_mm[j]) out.push_back(j);
+              if (supports.covers(j, (centres.row(j) - p).transpose())) out.push_back(j);
             }
           }
       std::sort(out.begin(), out.end());

@@ -1,9 +1,11 @@
 #pragma once
 // Which particle supports cover which points: a uniform cell grid (cell = the largest support
-// radius) over the centres, queried per point. Deterministic: each list is sorted by index.
+// semi-axis) over the centres, queried per point. Deterministic: each list is sorted by index.
 #include <Eigen/Dense>
 #include <cstdint>
 #include <vector>
+
+#include "solver/tissue/kernel_supports.h"
 
 namespace needle {
 
@@ -14,9 +16,9 @@ struct NeighbourLists {
   std::int64_t rows() const { return static_cast<std::int64_t>(offset.size()) - 1; }
 };
 
-// For each point i, every centre j with |points_i - centres_j| < radius_j (strictly inside its support).
-// points: #Q by 3, centres: #P by 3, radius_mm: #P.
+// For each point i, every centre j whose support holds it strictly inside (|points_i - centres_j| < radius_j
+// for spheres). points: #Q by 3, centres: #P by 3, supports: #P.
 NeighbourLists find_covering_centres(const Eigen::MatrixX3d& points, const Eigen::MatrixX3d& centres,
-                                     const Eigen::VectorXd& radius_mm);
+                                     const KernelSupports& supports);
 
 }  // namespace needle

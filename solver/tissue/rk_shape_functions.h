@@ -2,6 +2,7 @@
 // Reproducing-kernel (RK) shape functions with a linear basis and the cubic B-spline kernel
 // (Liu, Jun & Zhang 1995; Chen et al. 1996): for a point x covered by the supports of centres j,
 //   Psi_j(x) = H(0)^T M(x)^-1 H(x - X_j) phi(|x - X_j| / a_j),   H(d) = [1, d_x, d_y, d_z] / scale,
+// (phi(|(x - X_j) ./ a_j|) for ellipsoidal supports, kernel_supports.h)
 //   M(x)     = sum_j H(x - X_j) H(x - X_j)^T phi_j,
 // so that sum_j Psi_j = 1 and sum_j Psi_j X_j = x exactly (linear reproduction). Gradients are the
 // full derivatives (including dM/dx), so sum_j grad Psi_j = 0 and sum_j X_j (x) grad Psi_j = I exactly.
@@ -16,6 +17,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "solver/tissue/kernel_supports.h"
 #include "solver/tissue/neighbour_search.h"
 
 namespace needle {
@@ -52,18 +54,18 @@ inline void set_rk_entry(RkShapeFunctions& rk, std::int64_t e, double psi, const
 }
 
 // Shape functions of the centres evaluated at the centres themselves (rows = particles), with the
-// transpose. centres: #P by 3 (mm), support_radius_mm: #P (dilation x spacing).
-RkShapeFunctions build_rk_shape_functions(const Eigen::MatrixX3d& centres, const Eigen::VectorXd& support_radius_mm);
+// transpose. centres: #P by 3 (mm), supports: #P (spheres of dilation x spacing, or ellipsoids).
+RkShapeFunctions build_rk_shape_functions(const Eigen::MatrixX3d& centres, const KernelSupports& supports);
 // The same over given neighbour lists (row i: the centres allowed to cover particle i).
 RkShapeFunctions build_rk_shape_functions(const NeighbourLists& lists, const Eigen::MatrixX3d& centres,
-                                          const Eigen::VectorXd& support_radius_mm);
+                                          const KernelSupports& supports);
 
 // Shape functions of the centres evaluated at arbitrary points (no transpose), e.g. between particles.
 RkShapeFunctions evaluate_rk_shape_functions(const Eigen::MatrixX3d& points, const Eigen::MatrixX3d& centres,
-                                             const Eigen::VectorXd& support_radius_mm);
+                                             const KernelSupports& supports);
 
 // Re-evaluates the given rows (points = the rows' evaluation points) without their cut entries.
 void rebuild_rk_rows(RkShapeFunctions& rk, const std::vector<std::int64_t>& rows, const Eigen::MatrixX3d& points,
-                     const Eigen::MatrixX3d& centres, const Eigen::VectorXd& support_radius_mm);
+                     const Eigen::MatrixX3d& centres, const KernelSupports& supports);
 
 }  // namespace needle

@@ -2,7 +2,7 @@
 // The numerical choices of the SPG tissue, each a parameter whose error is measured (docs/solver.md).
 #include <string>
 
-#include <string>
+#include "solver/tissue/kernel_supports.h"
 
 namespace needle {
 
@@ -43,6 +43,9 @@ struct BondFailure {
 
 struct SpgOptions {
   double dilation = 1.8;  // support radius / particle spacing
+  // sphere: radius dilation x the largest neighbouring interval (the reference); ellipsoid: dilation x the
+  // interval along each axis (kernel_supports.h). The same on a uniform lattice.
+  SupportShape support = SupportShape::sphere;
   KernelUpdate kernel_update = KernelUpdate::lagrangian;
   int kernel_update_interval_steps = 50;
   Stabilization stabilization = Stabilization::penalty;

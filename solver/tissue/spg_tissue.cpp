@@ -66,10 +66,18 @@ SpgTissue::SpgTissue(const ParticleSet& set, const TissueMaterial& material, con
   p_.spacing_mm.assign(set.spacing_mm.data(), set.spacing_mm.data() + n);
   p_.flags.assign(set.flags.data(), set.flags.data() + n);
   p_.mass_g.resize(static_cast<size_t>(n));
-  p_.support_radius_mm.resize(static_cast<size_t>(n));
-  for (std::int64_t i = 0; i < n; ++i) {
-    p_.mass_g[static_cast<size_t>(i)] = rho * p_.reference_volume_mm3[static_cast<size_t>(i)];
-    p_.support_radius_mm[static_cast<size_t>(i)] = options_.dilation * p_.spacing_mm[static_cast<size_t>(i)];
+  for (std::int64_t i = 0; i < n; ++i) p_.mass_g[static_cast<size_t>(i)] = rho * p_.reference_volume_mm3[static_cast<size_t>(i)];
+  if (options_.support == SupportShape::sphere) {
+    p_.supports = KernelSupports(Eigen::VectorXd(options_.dilation * set.spacing_mm));
+  } else {
+    // A set without per-axis intervals (not a lattice) gets its largest interval along every axis.
+    const bool per_axis = set.axis_spacing_mm.rows() == n;
+    NEEDLE_REQUIRE(!per_axis || ((set.axis_spacing_mm.array() > 0).all() && set.axis_spacing_mm.allFinite()),
+                   "particle spacing along each axis must be positive");
+    Eigen::MatrixX3d semi_axes(n, 3);
+    for (std::int64_t i = 0; i < n; ++i)
+      semi_axes.row(i) = options_.dilation * (per_axis ? Eigen::RowVector3d(set.axis_spacing_mm.row(i)) : Eigen::RowVector3d::Constant(set.spacing_mm[i]));
+    p_.supports = KernelSupports::ellipsoids(semi_axes);
   }
   p_.deformation_gradient.assign(static_cast<size_t>(n), Mat3d::Identity());
   p_.stress_MPa.assign(static_cast<size_t>(n), Mat3d::Zero());
@@ -108,8 +116,7 @@ void SpgTissue::refresh_reference_matrix() {
 void SpgTissue::build_kernel() {
   refresh_reference_matrix();
   const Eigen::MatrixX3d& X = reference_;
-  const Eigen::Map<const Eigen::VectorXd> radius(p_.support_radius_mm.data(), p_.size());
-  rk_ = build_rk_shape_functions(X, radius);
+  rk_ = build_rk_shape_functions(X, p_.supports);
   bonds_ = build_bond_network(rk_);
   update_stable_lengths();
   update_shortest_bonds();
@@ -322,8 +329,7 @@ std::int64_t SpgTissue::separate(const std::vector<std::pair<std::int64_t, std::
   // that already collapsed once).
   rows.erase(std::remove_if(rows.begin(), rows.end(), [&](std::int64_t i) { return !rk_.valid[static_cast<size_t>(i)]; }), rows.end());
   if (rows.empty()) return count;
-  const Eigen::Map<const Eigen::VectorXd> radius(p_.support_radius_mm.data(), p_.size());
-  rebuild_rk_rows(rk_, rows, reference_, reference_, radius);
+  rebuild_rk_rows(rk_, rows, reference_, reference_, p_.supports);
   // The next stress increment must see only motion, not the change of shape functions: restart F there.
   // Every rebuilt row is on a crack face now: where its new support measures a collapsed volume it
   // detaches at once (as compute_forces would at the next evaluation), before its F can set the step.
@@ -410,8 +416,7 @@ void SpgTissue::reinitialize_kernel() {
   }
   refresh_reference_matrix();
   const Eigen::MatrixX3d& X = reference_;
-  const Eigen::Map<const Eigen::VectorXd> radius(p_.support_radius_mm.data(), n);
-  NeighbourLists all = find_covering_centres(X, X, radius);
+  NeighbourLists all = find_covering_centres(X, X, p_.supports);
   NeighbourLists kept;
   kept.offset.assign(all.offset.size(), 0);
   for (std::int64_t i = 0; i < n; ++i) {
@@ -422,7 +427,7 @@ void SpgTissue::reinitialize_kernel() {
     kept.offset[static_cast<size_t>(i + 1)] = static_cast<std::int64_t>(kept.index.size());
   }
   const std::int64_t broken_before = bonds_.broken_count;
-  rk_ = build_rk_shape_functions(kept, X, radius);
+  rk_ = build_rk_shape_functions(kept, X, p_.supports);
   bonds_ = build_bond_network(rk_);
   update_stable_lengths();
   update_shortest_bonds();

@@ -14,6 +14,7 @@
 
 #include "mesher/particle_lattice.h"
 #include "solver/tissue/bond_network.h"
+#include "solver/tissue/kernel_supports.h"
 #include "solver/tissue/rk_shape_functions.h"
 #include "solver/tissue/spg_options.h"
 #include "solver/tissue/tissue_material.h"
@@ -33,7 +34,7 @@ struct TissueParticles {
   std::vector<double> mass_g;
   std::vector<double> reference_volume_mm3;
   std::vector<double> spacing_mm;
-  std::vector<double> support_radius_mm;
+  KernelSupports supports;                // the kernel's supports in the reference (kernel_supports.h)
   std::vector<std::uint8_t> flags;        // ParticleFlag bits
   std::vector<Mat3d> deformation_gradient;  // relative to the kernel reference
   std::vector<Mat3d> stress_MPa;            // Cauchy

@@ -1,6 +1,7 @@
 // RK shape functions: partition of unity and linear reproduction (values and gradients) at the
 // particles and between them, on regular and jittered sets; gradients against finite differences;
-// rows rebuilt without cut entries keep both properties.
+// rows rebuilt without cut entries keep both properties; ellipsoidal supports on a graded lattice (the search
+// against all pairs, reproduction, derivatives, and the spheres on a uniform lattice).
 #include <catch2/catch.hpp>
 #include <random>
 
@@ -158,4 +159,105 @@ TEST_CASE("The transpose's copy of the values follows every rebuilt and cleared 
   for (double p : rk.psi) by_rows += std::abs(p);
   for (const std::array<double, 4>& v : rk.column_value) by_columns += std::abs(v[0]);
   CHECK(by_columns == Approx(by_rows).epsilon(1e-12));
+}
+
+namespace {
+
+// A lattice graded as the run's is: 0.2 mm intervals along x everywhere and in a band around the path,
+// 0.4 mm across y and z outside it.
+ParticleSet graded_lattice() {
+  TissueBox box;
+  box.min_mm = {0, -1.6, 0};
+  box.max_mm = {2.4, 1.6, 1.6};
+  box.faces.fill(FaceCondition::free);
+  LatticeOptions o;
+  o.spacing_mm = 0.4;
+  o.region_of_interest = RegionOfInterest{{0, -0.4, 0}, {2.4, 0.4, 0.4}, 2};
+  return make_particle_lattice(box, o);
+}
+
+KernelSupports ellipsoids(const ParticleSet& set, double dilation) { return KernelSupports::ellipsoids(dilation * set.axis_spacing_mm); }
+
+}  // namespace
+
+TEST_CASE("Ellipsoidal supports: the covering centres are those inside each ellipsoid, found by a search over all pairs", "[solver][rk]") {
+  const ParticleSet set = graded_lattice();
+  const KernelSupports s = ellipsoids(set, 1.8);
+  const NeighbourLists lists = find_covering_centres(set.x_mm, set.x_mm, s);
+  std::int64_t mismatched = 0, total = 0, sphere_total = 0;
+  for (std::int64_t i = 0; i < set.num_particles(); ++i) {
+    std::vector<std::int32_t> expected;
+    for (std::int32_t j = 0; j < set.num_particles(); ++j) {
+      const Eigen::Vector3d d = set.x_mm.row(i) - set.x_mm.row(j);
+      double q = 0;
+      for (int k = 0; k < 3; ++k) q += (d[k] / s.radius_mm(j, k)) * (d[k] / s.radius_mm(j, k));
+      if (q < 1) expected.push_back(j);
+      if (d.norm() < 1.8 * set.spacing_mm[j]) ++sphere_total;
+    }
+    const std::vector<std::int32_t> found(lists.index.begin() + lists.offset[static_cast<size_t>(i)],
+                                          lists.index.begin() + lists.offset[static_cast<size_t>(i + 1)]);
+    if (found != expected) ++mismatched;
+    total += static_cast<std::int64_t>(expected.size());
+  }
+  CHECK(mismatched == 0);
+  // The point of the ellipsoids: on this lattice a sphere of 1.8 x the largest interval holds far more centres.
+  INFO("entries: ellipsoids " << total << ", spheres " << sphere_total);
+  CHECK(sphere_total > 3 * total / 2);
+}
+
+TEST_CASE("Ellipsoidal supports reproduce linear fields at the particles and between them, with exact derivatives", "[solver][rk]") {
+  const ParticleSet set = graded_lattice();
+  const KernelSupports s = ellipsoids(set, 1.8);
+  const RkShapeFunctions rk = build_rk_shape_functions(set.x_mm, s);
+  const Worst at = check_rows(rk, set.x_mm, set.x_mm);
+  CHECK(at.unity < 1e-12);
+  CHECK(at.linear < 1e-12);
+  CHECK(at.gradient_unity < 1e-10);
+  CHECK(at.gradient_linear < 1e-12);
+
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  Eigen::MatrixX3d points(200, 3);
+  for (int i = 0; i < 200; ++i) points.row(i) << 2.4 * u(rng), -1.6 + 3.2 * u(rng), 1.6 * u(rng);
+  const Worst between = check_rows(evaluate_rk_shape_functions(points, set.x_mm, s), points, set.x_mm);
+  CHECK(between.unity < 1e-12);
+  CHECK(between.linear < 1e-12);
+  CHECK(between.gradient_linear < 1e-11);
+
+  // Derivatives by central differences at a point where fine and coarse supports overlap.
+  Eigen::MatrixX3d point(1, 3);
+  point.row(0) << 1.13, 0.47, 0.39;
+  const RkShapeFunctions centre = evaluate_rk_shape_functions(point, set.x_mm, s);
+  const double step = 1e-6;
+  double worst = 0, scale = 0;
+  for (int k = 0; k < 3; ++k) {
+    Eigen::MatrixX3d plus = point, minus = point;
+    plus(0, k) += step;
+    minus(0, k) -= step;
+    const RkShapeFunctions p = evaluate_rk_shape_functions(plus, set.x_mm, s);
+    const RkShapeFunctions m = evaluate_rk_shape_functions(minus, set.x_mm, s);
+    REQUIRE(p.centre == centre.centre);
+    REQUIRE(m.centre == centre.centre);
+    for (size_t e = 0; e < centre.centre.size(); ++e) {
+      worst = std::max(worst, std::abs((p.psi[e] - m.psi[e]) / (2 * step) - centre.grad[e][static_cast<size_t>(k)]));
+      scale = std::max(scale, std::abs(centre.grad[e][static_cast<size_t>(k)]));
+    }
+  }
+  CHECK(scale > 0.1);
+  CHECK(worst < 1e-6 * scale);
+}
+
+TEST_CASE("On a uniform lattice ellipsoidal supports are the spheres", "[solver][rk]") {
+  const ParticleSet set = needle_test::free_box({0, 0, 0}, {2, 2, 2}, 0.5);
+  Eigen::MatrixX3d axes(set.num_particles(), 3);
+  axes.col(0) = axes.col(1) = axes.col(2) = 1.8 * set.spacing_mm;
+  const RkShapeFunctions sphere = build_rk_shape_functions(set.x_mm, radii(set, 1.8));
+  const RkShapeFunctions ellipsoid = build_rk_shape_functions(set.x_mm, KernelSupports::ellipsoids(axes));
+  REQUIRE(ellipsoid.centre == sphere.centre);
+  double worst = 0;
+  for (size_t e = 0; e < sphere.psi.size(); ++e) {
+    worst = std::max(worst, std::abs(ellipsoid.psi[e] - sphere.psi[e]));
+    for (size_t k = 0; k < 3; ++k) worst = std::max(worst, std::abs(ellipsoid.grad[e][k] - sphere.grad[e][k]));
+  }
+  CHECK(worst < 1e-12);
 }
