@@ -3,7 +3,8 @@
 #include <filesystem>
 #include <fmt/format.h>
 #include <fstream>
-#include <functional>
+#include <cstdint>
+#include <limits>
 
 #include "core/input_error.h"
 #include "geometry/mesh_io.h"
@@ -25,67 +26,106 @@ void write_atomically(const std::string& path, const std::string& extension, Bod
   });
 }
 
-void write_array(std::ostream& out, const std::string& type, const std::string& name, int components,
-                 const std::function<void(std::ostream&)>& values) {
-  out << fmt::format("        <DataArray type=\"{}\" Name=\"{}\" NumberOfComponents=\"{}\" format=\"ascii\">\n", type, name, components);
-  values(out);
+template <class T>
+const char* vtk_type();
+template <>
+const char* vtk_type<double>() { return "Float64"; }
+template <>
+const char* vtk_type<std::int64_t>() { return "Int64"; }
+template <>
+const char* vtk_type<std::int32_t>() { return "Int32"; }
+template <>
+const char* vtk_type<std::uint8_t>() { return "UInt8"; }
+
+// RFC 4648 base64 of n bytes, padded.
+void write_base64(std::ostream& out, const unsigned char* bytes, size_t n) {
+  static constexpr char kDigits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string text;
+  text.reserve((n + 2) / 3 * 4);
+  for (size_t i = 0; i < n; i += 3) {
+    const unsigned b0 = bytes[i], b1 = i + 1 < n ? bytes[i + 1] : 0u, b2 = i + 2 < n ? bytes[i + 2] : 0u;
+    const unsigned triple = (b0 << 16) | (b1 << 8) | b2;
+    text += kDigits[(triple >> 18) & 63];
+    text += kDigits[(triple >> 12) & 63];
+    text += i + 1 < n ? kDigits[(triple >> 6) & 63] : '=';
+    text += i + 2 < n ? kDigits[triple & 63] : '=';
+  }
+  out << text;
+}
+
+// One DataArray of the given values (row after row), as text or as base64 with its byte count ahead.
+template <class T>
+void write_array(std::ostream& out, VtkEncoding encoding, const std::string& name, int components, const std::vector<T>& values) {
+  out << fmt::format("        <DataArray type=\"{}\" Name=\"{}\" NumberOfComponents=\"{}\" format=\"{}\">\n", vtk_type<T>(), name,
+                     components, encoding == VtkEncoding::ascii ? "ascii" : "binary");
+  if (encoding == VtkEncoding::ascii) {
+    for (const T& v : values) out << +v << ' ';  // + prints a UInt8 as a number
+  } else {
+    static_assert(sizeof(double) == 8 && std::numeric_limits<double>::is_iec559, "VTK's Float64 is an IEEE double");
+    const std::uint64_t bytes = values.size() * sizeof(T);  // little-endian machines only (x86-64, aarch64)
+    write_base64(out, reinterpret_cast<const unsigned char*>(&bytes), sizeof bytes);
+    write_base64(out, reinterpret_cast<const unsigned char*>(values.data()), static_cast<size_t>(bytes));
+  }
   out << "\n        </DataArray>\n";
 }
 
-void write_field(std::ostream& out, const VtkField& field, int padding_rows) {
-  write_array(out, "Float64", field.name, static_cast<int>(field.values.cols()), [&](std::ostream& o) {
-    for (Eigen::Index r = 0; r < field.values.rows(); ++r)
-      for (Eigen::Index c = 0; c < field.values.cols(); ++c) o << field.values(r, c) << ' ';
-    for (int r = 0; r < padding_rows * field.values.cols(); ++r) o << "0 ";
-  });
+void write_field(std::ostream& out, VtkEncoding encoding, const VtkField& field, int padding_rows) {
+  std::vector<double> values;
+  values.reserve(static_cast<size_t>((field.values.rows() + padding_rows) * field.values.cols()));
+  for (Eigen::Index r = 0; r < field.values.rows(); ++r)
+    for (Eigen::Index c = 0; c < field.values.cols(); ++c) values.push_back(field.values(r, c));
+  values.resize(values.size() + static_cast<size_t>(padding_rows * field.values.cols()), 0.0);
+  write_array(out, encoding, field.name, static_cast<int>(field.values.cols()), values);
 }
 
-void write_points(std::ostream& out, const Eigen::MatrixX3d& X) {
+void write_points(std::ostream& out, VtkEncoding encoding, const Eigen::MatrixX3d& X) {
   out << "      <Points>\n";
-  write_array(out, "Float64", "position_mm", 3, [&](std::ostream& o) {
-    for (Eigen::Index i = 0; i < X.rows(); ++i) o << X(i, 0) << ' ' << X(i, 1) << ' ' << X(i, 2) << ' ';
-  });
+  write_field(out, encoding, VtkField{"position_mm", X}, 0);
   out << "      </Points>\n";
+}
+
+std::string file_header(const char* type, VtkEncoding encoding) {
+  return fmt::format("<?xml version=\"1.0\"?>\n<VTKFile type=\"{}\" version=\"1.0\" byte_order=\"LittleEndian\"{}>\n", type,
+                     encoding == VtkEncoding::binary ? " header_type=\"UInt64\"" : "");
 }
 
 }  // namespace
 
 void write_vtu(const std::string& path, const TetMesh& mesh, const std::vector<VtkField>& tet_fields,
-               const std::vector<VtkField>& point_fields) {
+               const std::vector<VtkField>& point_fields, VtkEncoding encoding) {
   for (const VtkField& f : tet_fields)
     if (f.values.rows() != mesh.num_tets()) throw std::logic_error("write_vtu: tet field " + f.name + " has the wrong size");
   for (const VtkField& f : point_fields)
     if (f.values.rows() != mesh.num_nodes()) throw std::logic_error("write_vtu: point field " + f.name + " has the wrong size");
   write_atomically(path, ".vtu", [&](std::ostream& out) {
     const int tets = mesh.num_tets(), faces = mesh.num_boundary_faces();
-    out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\">\n"
-        << "  <UnstructuredGrid>\n"
+    out << file_header("UnstructuredGrid", encoding) << "  <UnstructuredGrid>\n"
         << fmt::format("    <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">\n", mesh.num_nodes(), tets + faces);
-    write_points(out, mesh.X);
+    write_points(out, encoding, mesh.X);
     out << "      <Cells>\n";
-    write_array(out, "Int64", "connectivity", 1, [&](std::ostream& o) {
-      for (int t = 0; t < tets; ++t)
-        for (int c = 0; c < mesh.T.cols(); ++c) o << mesh.T(t, c) << ' ';
-      for (int f = 0; f < faces; ++f)
-        for (int c = 0; c < mesh.boundary_faces.cols(); ++c) o << mesh.boundary_faces(f, c) << ' ';
-    });
-    write_array(out, "Int64", "offsets", 1, [&](std::ostream& o) {
-      long offset = 0;
-      for (int t = 0; t < tets; ++t) o << (offset += mesh.T.cols()) << ' ';
-      for (int f = 0; f < faces; ++f) o << (offset += mesh.boundary_faces.cols()) << ' ';
-    });
-    write_array(out, "UInt8", "types", 1, [&](std::ostream& o) {
-      for (int t = 0; t < tets; ++t) o << (mesh.order == 2 ? 24 : 10) << ' ';
-      for (int f = 0; f < faces; ++f) o << (mesh.order == 2 ? 22 : 5) << ' ';
-    });
+    std::vector<std::int64_t> connectivity, offsets;
+    std::vector<std::uint8_t> types;
+    std::vector<std::int32_t> tags;
+    for (int t = 0; t < tets; ++t) {
+      for (int c = 0; c < mesh.T.cols(); ++c) connectivity.push_back(mesh.T(t, c));
+      offsets.push_back(static_cast<std::int64_t>(connectivity.size()));
+      types.push_back(mesh.order == 2 ? 24 : 10);
+      tags.push_back(-1);
+    }
+    for (int f = 0; f < faces; ++f) {
+      for (int c = 0; c < mesh.boundary_faces.cols(); ++c) connectivity.push_back(mesh.boundary_faces(f, c));
+      offsets.push_back(static_cast<std::int64_t>(connectivity.size()));
+      types.push_back(mesh.order == 2 ? 22 : 5);
+      tags.push_back(mesh.boundary_tag(f));
+    }
+    write_array(out, encoding, "connectivity", 1, connectivity);
+    write_array(out, encoding, "offsets", 1, offsets);
+    write_array(out, encoding, "types", 1, types);
     out << "      </Cells>\n      <CellData Scalars=\"boundary_tag\">\n";
-    write_array(out, "Int32", "boundary_tag", 1, [&](std::ostream& o) {
-      for (int t = 0; t < tets; ++t) o << "-1 ";
-      for (int f = 0; f < faces; ++f) o << mesh.boundary_tag(f) << ' ';
-    });
-    for (const VtkField& f : tet_fields) write_field(out, f, faces);
+    write_array(out, encoding, "boundary_tag", 1, tags);
+    for (const VtkField& f : tet_fields) write_field(out, encoding, f, faces);
     out << "      </CellData>\n      <PointData>\n";
-    for (const VtkField& f : point_fields) write_field(out, f, 0);
+    for (const VtkField& f : point_fields) write_field(out, encoding, f, 0);
     out << "      </PointData>\n    </Piece>\n  </UnstructuredGrid>\n";
     // The tag names, so that a reader knows which boundary_tag is which face.
     out << "  <!-- boundary_tag:";
@@ -94,24 +134,24 @@ void write_vtu(const std::string& path, const TetMesh& mesh, const std::vector<V
   });
 }
 
-void write_vtp(const std::string& path, const Eigen::MatrixX3d& points, const std::vector<VtkField>& point_fields) {
+void write_vtp(const std::string& path, const Eigen::MatrixX3d& points, const std::vector<VtkField>& point_fields, VtkEncoding encoding) {
   for (const VtkField& f : point_fields)
     if (f.values.rows() != points.rows()) throw std::logic_error("write_vtp: field " + f.name + " has the wrong size");
   write_atomically(path, ".vtp", [&](std::ostream& out) {
     const Eigen::Index n = points.rows();
-    out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\">\n"
-        << "  <PolyData>\n"
+    out << file_header("PolyData", encoding) << "  <PolyData>\n"
         << fmt::format("    <Piece NumberOfPoints=\"{}\" NumberOfVerts=\"{}\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n", n, n);
-    write_points(out, points);
+    write_points(out, encoding, points);
     out << "      <Verts>\n";
-    write_array(out, "Int64", "connectivity", 1, [&](std::ostream& o) {
-      for (Eigen::Index i = 0; i < n; ++i) o << i << ' ';
-    });
-    write_array(out, "Int64", "offsets", 1, [&](std::ostream& o) {
-      for (Eigen::Index i = 0; i < n; ++i) o << i + 1 << ' ';
-    });
+    std::vector<std::int64_t> connectivity(static_cast<size_t>(n)), offsets(static_cast<size_t>(n));
+    for (Eigen::Index i = 0; i < n; ++i) {
+      connectivity[static_cast<size_t>(i)] = i;
+      offsets[static_cast<size_t>(i)] = i + 1;
+    }
+    write_array(out, encoding, "connectivity", 1, connectivity);
+    write_array(out, encoding, "offsets", 1, offsets);
     out << "      </Verts>\n      <PointData>\n";
-    for (const VtkField& f : point_fields) write_field(out, f, 0);
+    for (const VtkField& f : point_fields) write_field(out, encoding, f, 0);
     out << "      </PointData>\n    </Piece>\n  </PolyData>\n</VTKFile>\n";
   });
 }

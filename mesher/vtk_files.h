@@ -1,6 +1,8 @@
 #pragma once
-// ParaView files in VTK's XML format (ASCII, so that a person can read them too): .vtu for tet meshes,
-// .vtp for particles. Each file appears complete or not at all.
+// ParaView files in VTK's XML format: .vtu for tet meshes, .vtp for particles. ASCII by default, so that a
+// person can read them too; binary (base64 inline, header_type UInt64, uncompressed, the header and the data
+// encoded apart as VTK and meshio read them) for the run's frames, where formatting 17-digit numbers cost a
+// run more than its contact search did. Each file appears complete or not at all.
 #include <Eigen/Dense>
 #include <string>
 #include <utility>
@@ -9,6 +11,8 @@
 #include "mesher/tet_mesh.h"
 
 namespace needle {
+
+enum class VtkEncoding { ascii, binary };
 
 // A named data array: #rows values with 1 (scalar) or 3 (vector) components.
 struct VtkField {
@@ -20,9 +24,10 @@ struct VtkField {
 // VTK_QUADRATIC_TRIANGLE). Cell data: `boundary_tag` (-1 on tets) plus tet_fields (given per tet,
 // written as 0 on the faces); point data: point_fields.
 void write_vtu(const std::string& path, const TetMesh& mesh, const std::vector<VtkField>& tet_fields = {},
-               const std::vector<VtkField>& point_fields = {});
+               const std::vector<VtkField>& point_fields = {}, VtkEncoding encoding = VtkEncoding::ascii);
 
 // Points as VTK_VERTEX cells with point data.
-void write_vtp(const std::string& path, const Eigen::MatrixX3d& points, const std::vector<VtkField>& point_fields = {});
+void write_vtp(const std::string& path, const Eigen::MatrixX3d& points, const std::vector<VtkField>& point_fields = {},
+               VtkEncoding encoding = VtkEncoding::ascii);
 
 }  // namespace needle

@@ -61,7 +61,7 @@ void write_needle_vtu(const std::string& path, const NeedleModel& run) {
   deformed.X = run.positions_mm();
   const ElementStresses stresses = run.element_stresses();
   write_vtu(path, deformed, {{"von_mises_MPa", stresses.von_mises_MPa}, {"cauchy_stress_MPa", stresses.cauchy_MPa}},
-            {{"displacement_mm", run.displacements_mm()}, {"velocity_m_per_s", run.velocities_mm_per_ms()}});
+            {{"displacement_mm", run.displacements_mm()}, {"velocity_m_per_s", run.velocities_mm_per_ms()}}, VtkEncoding::binary);
 }
 
 }  // namespace needle

@@ -1,12 +1,15 @@
 // Other projects' readers open what the toolkit writes: meshio (python3-meshio) and VTK (ParaView's, python3-paraview) read the
 // exported surfaces (STL binary and ASCII, OBJ, PLY) with our triangles and area, gmsh reads the STL files, and VTK
-// reads the T10 mesh (VTU) and the particle set (VTP) with their counts.
+// reads the T10 mesh (VTU) and the particle set (VTP) with their counts; VTK and meshio read our binary and ASCII
+// VTU and VTP value for value (meshio: the VTU; it has no VTP reader).
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <gmsh.h>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -14,6 +17,7 @@
 #include "geometry/mesh_io.h"
 #include "geometry/surface_measures.h"
 #include "mesher/gmsh_session.h"
+#include "mesher/vtk_files.h"
 
 using namespace needle;
 namespace fs = std::filesystem;
@@ -148,4 +152,64 @@ TEST_CASE("VTK reads the T10 mesh (VTU) and the particle set (VTP) the commands 
   CHECK(nodes == mesh.at("nodes").get<long>());
   CHECK(tets == mesh.at("tets").get<long>());
   CHECK(particles == set.at("particles").get<long>());
+}
+
+TEST_CASE("VTK and meshio read the binary and the ASCII VTU and VTP files value for value", "[geometry][io]") {
+  const fs::path dir = fresh_dir("vtk_binary");
+  // Two tets sharing a face, their four outer faces tagged; values with all 17 digits, a tiny and a huge one.
+  TetMesh mesh;
+  mesh.X.resize(5, 3);
+  mesh.X << 0, 0, 0, 1.0 / 3, 0, 0, 0, 1, 0, 0, 0, 1, 1e-300, 2e300, -0.1;
+  mesh.T.resize(2, 4);
+  mesh.T << 0, 1, 2, 3, 1, 2, 3, 4;
+  mesh.boundary_faces.resize(2, 3);
+  mesh.boundary_faces << 0, 2, 1, 1, 2, 4;
+  mesh.boundary_tag.resize(2);
+  mesh.boundary_tag << 0, 1;
+  mesh.tag_names = {"bottom", "side"};
+  Eigen::MatrixXd per_tet(2, 1), per_node(5, 3);
+  per_tet << M_PI, -std::exp(1.0);
+  for (int i = 0; i < 5; ++i)
+    for (int k = 0; k < 3; ++k) per_node(i, k) = std::sqrt(2.0 + i) * (k - 1) / 7.0;
+  for (const auto& [name, encoding] : {std::pair{"binary", VtkEncoding::binary}, std::pair{"ascii", VtkEncoding::ascii}}) {
+    const std::string vtu = (dir / (std::string(name) + ".vtu")).string(), vtp = (dir / (std::string(name) + ".vtp")).string();
+    write_vtu(vtu, mesh, {{"pressure", per_tet}}, {{"velocity", per_node}}, encoding);
+    write_vtp(vtp, mesh.X, {{"velocity", per_node}}, encoding);
+    const std::string script =
+        "import vtk, meshio\n"
+        "from vtk.util.numpy_support import vtk_to_numpy\n"
+        "u = vtk.vtkXMLUnstructuredGridReader(); u.SetFileName('" + vtu + "'); u.Update(); g = u.GetOutput()\n"
+        "p = vtk.vtkXMLPolyDataReader(); p.SetFileName('" + vtp + "'); p.Update(); q = p.GetOutput()\n"
+        "vals = list(vtk_to_numpy(g.GetPoints().GetData()).ravel()) + list(vtk_to_numpy(g.GetCellData().GetArray('pressure')).ravel())\n"
+        "vals += list(vtk_to_numpy(g.GetPointData().GetArray('velocity')).ravel()) + list(vtk_to_numpy(q.GetPoints().GetData()).ravel())\n"
+        "vals += list(vtk_to_numpy(q.GetPointData().GetArray('velocity')).ravel())\n"
+        "vals += list(vtk_to_numpy(g.GetCellData().GetArray('boundary_tag')).ravel())\n"
+        "vals += [g.GetCellType(i) for i in range(g.GetNumberOfCells())] + [g.GetCell(1).GetPointId(3), q.GetNumberOfVerts()]\n"
+        "m = meshio.read('" + vtu + "')\n"
+        "vals += list(m.points.ravel()) + list(m.point_data['velocity'].ravel())\n"
+        "print(' '.join(repr(float(v)) for v in vals))\n";
+    const std::string out = run_python(dir, script);
+    INFO(name << ": " << out);
+    std::vector<double> expected;
+    const auto add = [&expected](const Eigen::MatrixXd& m) {
+      for (Eigen::Index r = 0; r < m.rows(); ++r)
+        for (Eigen::Index c = 0; c < m.cols(); ++c) expected.push_back(m(r, c));
+    };
+    add(mesh.X);
+    add(Eigen::MatrixXd((Eigen::MatrixXd(4, 1) << per_tet, Eigen::MatrixXd::Zero(2, 1)).finished()));  // 0 on the faces
+    add(per_node);
+    add(mesh.X);
+    add(per_node);
+    for (double v : {-1.0, -1.0, 0.0, 1.0, 10.0, 10.0, 5.0, 5.0, 4.0, 5.0}) expected.push_back(v);
+    add(mesh.X);
+    add(per_node);
+    std::vector<double> read;
+    std::istringstream words(out);
+    for (double v; words >> v;) read.push_back(v);
+    REQUIRE(read.size() == expected.size());
+    for (size_t i = 0; i < read.size(); ++i) {
+      INFO("value " << i);
+      CHECK(read[i] == expected[i]);  // both encodings carry every bit
+    }
+  }
 }
