@@ -27,12 +27,28 @@ double TissueMaterial::hardening_slope_MPa(double plastic_strain, double factor)
   return factor * k_MPa * n * std::pow(yield_strain() + plastic_strain, n - 1.0);
 }
 
-Eigen::Vector3d mat018_deviatoric_stress(const TissueMaterial& m, double rate, const Eigen::Vector3d& h_dev, Eigen::Vector3d& h, double& eps_p,
-                                         bool& capped) {
-  const double factor = m.rate_factor(rate, &capped);
+bool TissueMaterial::rate_factor_uncapped_up_to(double strain_rate_per_ms) const {
+  if (rate_law == RateLaw::off || !(strain_rate_per_ms > 0)) return true;
+  if (!std::isfinite(strain_rate_per_ms)) return false;
+  const double exponent = rate_law == RateLaw::printed ? 1.0 / rate_p : rate_p;
+  const double log_term = exponent * std::log(strain_rate_per_ms / rate_C_per_ms);  // rises with the rate
+  const double log_cap = std::log(max_rate_factor - 1.0 > 0 ? max_rate_factor - 1.0 : 1e-300);
+  return log_term < log_cap - 1e-9 * (1 + std::abs(log_cap));
+}
+
+Eigen::Vector3d mat018_deviatoric_stress(const TissueMaterial& m, const IncrementStrainRate& rate, const Eigen::Vector3d& h_dev,
+                                         Eigen::Vector3d& h, double& eps_p, bool& capped) {
   const double mu = m.shear_modulus_MPa();
   Eigen::Vector3d s = 2 * mu * h_dev;  // principal deviatoric Cauchy stress
   const double q_trial = std::sqrt(1.5 * s.squaredNorm());
+  // The rate factor is at least 1 and only raises the yield stress: a trial within the yield stress at factor 1 is
+  // elastic at any rate, and where the rate cannot reach the factor's cap either, the rate is not needed (most
+  // particles, most steps: it is an eigenvalue problem).
+  if (q_trial <= m.yield_stress_MPa(eps_p, 1.0) && m.rate_factor_uncapped_up_to(rate.upper_bound())) {
+    capped = false;
+    return s;
+  }
+  const double factor = m.rate_factor(rate.value(), &capped);
   if (q_trial > m.yield_stress_MPa(eps_p, factor)) {
     // Radial return: q_trial - 3 mu dg = sigma_y(eps_p + dg); Newton with bisection bounds.
     double lo = 0.0, hi = q_trial / (3 * mu), dg = 0.0;

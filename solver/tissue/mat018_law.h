@@ -10,9 +10,10 @@ namespace needle {
 
 // The deviatoric principal Cauchy stress of the elastic trial 2 mu h_dev, returned radially onto the yield
 // surface where it lies beyond it: the plastic multiplier moves the principal log strain h and eps_p.
-// rate: the increment's effective strain rate (1/ms); capped is set when the rate factor hit its cap.
-Eigen::Vector3d mat018_deviatoric_stress(const TissueMaterial& m, double rate_per_ms, const Eigen::Vector3d& h_dev, Eigen::Vector3d& h,
-                                         double& eps_p, bool& capped);
+// rate: the increment's effective strain rate (1/ms), asked for only where it can matter; capped is set when the
+// rate factor hit its cap.
+Eigen::Vector3d mat018_deviatoric_stress(const TissueMaterial& m, const IncrementStrainRate& rate, const Eigen::Vector3d& h_dev,
+                                         Eigen::Vector3d& h, double& eps_p, bool& capped);
 
 // The closed-form uniaxial curve (tissue_material.h: uniaxial_true_stress_MPa) of the card.
 double mat018_uniaxial_true_stress_MPa(const TissueMaterial& m, double true_strain, double strain_rate_per_ms);

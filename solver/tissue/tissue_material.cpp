@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <fmt/format.h>
 
 #include "core/input_error.h"
@@ -68,6 +69,28 @@ double TissueMaterial::tangent_p_wave_modulus_MPa(double effective_strain) const
   return bulk_modulus_MPa() + 4.0 / 3.0 * tangent_shear_modulus_MPa(effective_strain);
 }
 
+double IncrementStrainRate::value() const {
+  if (value_ >= 0) return value_;
+  value_ = 0.0;
+  if (dt_ms_ > 0) {
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> inc;
+    inc.computeDirect(f_ * f_.transpose(), Eigen::EigenvaluesOnly);
+    Eigen::Vector3d d = 0.5 * inc.eigenvalues().cwiseMax(1e-300).array().log().matrix();
+    d.array() -= d.mean();
+    value_ = std::sqrt(2.0 / 3.0 * d.squaredNorm()) / dt_ms_;
+  }
+  return value_;
+}
+
+double IncrementStrainRate::upper_bound() const {
+  if (!(dt_ms_ > 0)) return 0.0;
+  const double r = (f_ * f_.transpose() - Eigen::Matrix3d::Identity()).norm();  // bounds |eig(f f^T) - 1|
+  if (!(r < 0.5)) return std::numeric_limits<double>::infinity();
+  // |dev d| <= |d| <= sqrt(3) max |d_i|, so the rate <= sqrt(2/3) sqrt(3) (-1/2 ln(1 - r)) / dt; the margins cover the
+  // rounding of the eigenvalues and logarithms value() computes (about 1e-16 each).
+  return (std::sqrt(0.5) * -std::log1p(-r) * (1 + 1e-6) + 1e-12) / dt_ms_;
+}
+
 StressUpdate update_stress(const TissueMaterial& m, const MaterialPoint& state, const Eigen::Matrix3d& f, double dt_ms) {
   const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
   // Elastic trial: b_e = f b_e f^T, principal log strains.
@@ -77,15 +100,8 @@ StressUpdate update_stress(const TissueMaterial& m, const MaterialPoint& state, 
   const Eigen::Vector3d lambda_sq = eig.eigenvalues().cwiseMax(1e-300);
   Eigen::Vector3d h = 0.5 * lambda_sq.array().log().matrix();
 
-  // Effective strain rate of the increment, from the deviatoric log strain of f f^T.
-  double rate = 0.0;
-  if (dt_ms > 0) {
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> inc;
-    inc.computeDirect(f * f.transpose(), Eigen::EigenvaluesOnly);
-    Eigen::Vector3d d = 0.5 * inc.eigenvalues().cwiseMax(1e-300).array().log().matrix();
-    d.array() -= d.mean();
-    rate = std::sqrt(2.0 / 3.0 * d.squaredNorm()) / dt_ms;
-  }
+  // Effective strain rate of the increment, from the deviatoric log strain of f f^T: the law asks for it.
+  const IncrementStrainRate rate(f, dt_ms);
   bool capped = false;
 
   const double mu = m.shear_modulus_MPa(), lambda = m.lame_lambda_MPa();

@@ -74,8 +74,25 @@ struct TissueMaterial {
   double yield_strain() const;  // eps_yp
   // Rate factor at an effective strain rate (1/ms); `capped` set when the cap applied.
   double rate_factor(double strain_rate_per_ms, bool* capped = nullptr) const;
+  // Whether rate_factor stays below its cap for every rate up to this one (rate_factor never falls below 1).
+  bool rate_factor_uncapped_up_to(double strain_rate_per_ms) const;
   double yield_stress_MPa(double plastic_strain, double rate_factor) const;
   double hardening_slope_MPa(double plastic_strain, double rate_factor) const;
+};
+
+// The effective strain rate of an increment f over dt_ms, sqrt(2/3 |dev d|^2) / dt with d = 1/2 ln eig(f f^T)
+// (0 when dt is 0). value() solves the eigenvalue problem, once, when first asked; upper_bound() needs only
+// |f f^T - I|: every eigenvalue of f f^T lies within that of 1, so |d_i| <= -1/2 ln(1 - |f f^T - I|).
+class IncrementStrainRate {
+ public:
+  IncrementStrainRate(const Eigen::Matrix3d& f, double dt_ms) : f_(f), dt_ms_(dt_ms) {}
+  double value() const;
+  double upper_bound() const;  // >= value(), rounding included; infinite for increments beyond |f f^T - I| = 1
+
+ private:
+  Eigen::Matrix3d f_;
+  double dt_ms_;
+  mutable double value_ = -1;  // < 0: not computed yet
 };
 
 // Material state at one point and its update over one increment. Elasticity is Hencky's, written in

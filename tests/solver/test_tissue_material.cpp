@@ -3,6 +3,7 @@
 // bisection on the scalar law).
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <random>
 
 #include "core/input_error.h"
 #include "solver/tissue/spg_tissue.h"
@@ -60,6 +61,46 @@ TEST_CASE("The rate factor follows Cowper-Symonds and never overflows", "[solver
   CHECK(std::isfinite(m.rate_factor(1e300)));
   m.rate_law = RateLaw::off;
   CHECK(m.rate_factor(1e3) == 1.0);
+}
+
+TEST_CASE("The increment's strain rate: its cheap bound lies above the eigenvalue rate, and an elastic trial still reports the cap",
+          "[solver][material]") {
+  // The stress update asks for the rate only where it can matter (mat018_law.cpp): it must never skip a rate that
+  // would have capped the factor. First the bound, over random increments from tiny to large.
+  std::mt19937 rng(11);
+  std::normal_distribution<double> g(0.0, 1.0);
+  int bounded = 0, tried = 0;
+  for (double size : {1e-7, 1e-4, 1e-2, 0.1, 0.3})
+    for (int k = 0; k < 200; ++k) {
+      Eigen::Matrix3d a;
+      for (int i = 0; i < 9; ++i) a(i / 3, i % 3) = g(rng);
+      const Eigen::Matrix3d f = Eigen::Matrix3d::Identity() + size * a / a.norm();
+      const IncrementStrainRate rate(f, 0.002);
+      ++tried;
+      if (rate.upper_bound() >= rate.value()) ++bounded;
+      if (size <= 0.1) CHECK(rate.upper_bound() <= 10 * rate.value() + 1e-6);  // a bound that helps: within an order of magnitude
+    }
+  CHECK(bounded == tried);
+  CHECK(IncrementStrainRate(isochoric(0.01), 0.0).value() == 0.0);
+  CHECK(IncrementStrainRate(isochoric(0.01), 0.1).value() == Approx(0.1).epsilon(1e-9));  // an isochoric stretch: rate = its log stretch / dt
+
+  // The printed law caps at 1 + (rate / C)^10 = 1000, i.e. from 0.1995 /ms: a small, elastic, fast increment is capped.
+  TissueMaterial m;
+  m.rate_law = RateLaw::printed;
+  for (const auto& [dt, capped] : {std::pair{0.01, true}, std::pair{1.0, false}, std::pair{0.0502, false}, std::pair{0.0500, true}}) {
+    const StressUpdate u = update_stress(m, MaterialPoint{}, isochoric(0.01), dt);  // 0.01 over dt: 1 /ms, 0.01 /ms, 0.1992 and 0.2 /ms
+    INFO("dt " << dt);
+    CHECK(u.rate_factor_capped == capped);
+    CHECK(u.state.plastic_strain == 0.0);
+    bool c = false;
+    m.rate_factor(0.01 / dt, &c);
+    CHECK(c == capped);
+  }
+  for (double r : {1e-3, 0.1, 0.199, 0.2, 1.0, 1e3}) {
+    bool c = false;
+    m.rate_factor(r, &c);
+    if (m.rate_factor_uncapped_up_to(r)) CHECK_FALSE(c);
+  }
 }
 
 TEST_CASE("The stress update is objective: a rigid rotation rotates the stress", "[solver][material]") {
