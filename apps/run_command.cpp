@@ -8,6 +8,7 @@
 
 #include "apps/cli_checks.h"
 #include "runs/insertion_run.h"
+#include "runs/model_levels.h"
 #include "apps/scene_overrides.h"
 #include "runs/scene.h"
 #include "core/input_error.h"
@@ -42,7 +43,13 @@ void run(const RunCommandOptions& o) {
     scene.tissue.material.E_MPa = o.tissue_E_MPa;
     E_source = "given with --tissue-E-MPa";
   } else if (!o.calibration_file.empty() || o.scene_file.empty()) {
-    const std::string file = o.calibration_file.empty() ? default_calibration_file() : o.calibration_file;
+    // The shipped calibration of the model level the run will have (--model and --set come last).
+    const auto level = [&] {
+      Scene probe = scene;
+      apply_scene_overrides(probe, o.overrides);
+      return model_level_of(probe);
+    };
+    const std::string file = o.calibration_file.empty() ? default_calibration_file(level()) : o.calibration_file;
     scene.tissue.material.E_MPa = calibrated_E(file);
     E_source = fmt::format("calibrated on SB: {}", file);
   }
@@ -77,8 +84,8 @@ void add_run_command(CLI::App& app) {
   c->add_option("--mesh-size-mm", o->overrides.mesh_size_mm, "Needle mesh size over the tip and groove (run default 0.4; paper 0.2)");
   c->add_option("--mass-scaling-dt-ms", o->mass_scaling_dt_ms, "Needle selective mass scaling target step (run default 5e-6; 0: off)");
   c->add_option("--tissue-E-MPa", o->tissue_E_MPa,
-                "Tissue Young's modulus (the calibrated parameter; default: the SB calibration data/paper/calibration_sb.json, 0.078; "
-                "the paper's card: 0.665)");
+                "Tissue Young's modulus (the calibrated parameter; default: the model level's SB calibration, data/paper/calibration_sb.json "
+                "for the fast level, calibration_sb_full.json for the full and projection levels; the paper's card: 0.665)");
   c->add_option("--calibration", o->calibration_file, "Take the tissue's E from this calibration (`needle calibrate`'s calibration.json)");
   c->add_option("--frames", o->frames, "ParaView frames over the run (default 20; 0: none)")->check(count_check());
   c->add_flag("--no-subcycling", o->no_subcycling, "Tissue takes the needle's step (the plain full model; slow)");

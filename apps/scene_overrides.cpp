@@ -99,7 +99,7 @@ void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
 void add_scene_override_options(CLI::App* c, SceneOverrides& o) {
   std::string levels;
   for (const ModelLevel& level : model_levels()) levels += fmt::format("{}{}: {}", levels.empty() ? "" : "; ", level.name, level.description);
-  c->add_option("--model", o.model, fmt::format("The model level ({}; default: the scene's, the run defaults' full)", levels));
+  c->add_option("--model", o.model, fmt::format("The model level ({}; default: the scene's; the run defaults' fast)", levels));
   c->add_option("--set", o.settings,
                 "Set any scene key, KEY=VALUE with the scene file's dotted names and units, e.g. --set tissue.material.nu=0.49 "
                 "--set 'motion.travel=10 mm' (docs/scenes.md); repeatable, applied after the other flags");

@@ -155,7 +155,8 @@ class InsertionOutput {
     const std::string tissue_name = fmt::format("frames/tissue_{:04}.vtp", index);
     write_vtp(folder_.path(tissue_name).string(), x,
               {{"displacement_mm", u}, {"velocity_m_per_s", v}, {"plastic_strain", plastic}, {"effective_strain", effective}, {"von_mises_MPa", mises},
-               {"broken_bonds", broken_bonds(run.tissue())}, {"in_contact", contact}});
+               {"broken_bonds", broken_bonds(run.tissue())}, {"in_contact", contact}},
+              VtkEncoding::binary);
     tissue_frames_.emplace_back(run.time_ms(), tissue_name);
   }
 
@@ -175,7 +176,10 @@ class InsertionOutput {
 
 }  // namespace
 
-std::string default_calibration_file() { return std::string(NEEDLE_DATA_DIR) + "/paper/calibration_sb.json"; }
+std::string default_calibration_file(const std::string& model_level) {
+  const bool full_model = model_level == "full" || model_level == "projection";
+  return std::string(NEEDLE_DATA_DIR) + (full_model ? "/paper/calibration_sb_full.json" : "/paper/calibration_sb.json");
+}
 
 double calibrated_E(const std::string& path) {
   const json j = read_json_file(path, "calibration");
@@ -190,6 +194,7 @@ Scene default_run_scene() {
   s.needle.mesh.size_mm = 0.4;
   s.solver.mass_scaling_dt_ms = 5e-6;
   s.tissue.path_refinement = 2;  // 0.2 mm particles within 1.2 mm of the path: the tip's bevels see tissue
+  apply_model_level(s, kDefaultModelLevel, "the run defaults");
   return s;
 }
 

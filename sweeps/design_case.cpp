@@ -131,9 +131,9 @@ CaseSetup case_setup(const DesignBase& b, const json& values) {
   Scene scene = b.scene_file.empty() ? default_run_scene() : read_scene(b.scene_file);
   scene.tissue.enabled = true;
   if (!b.preset.empty() || !b.recipe_file.empty() || std::isfinite(b.d_a_mm)) scene.needle.select_source(b.preset, b.d_a_mm, b.recipe_file);
-  if (!b.calibration_file.empty() || b.scene_file.empty())
-    scene.tissue.material.E_MPa = calibrated_E(b.calibration_file.empty() ? default_calibration_file() : b.calibration_file);
   if (!b.model.empty()) apply_model_level(scene, b.model, "model");
+  if (!b.calibration_file.empty() || b.scene_file.empty())
+    scene.tissue.material.E_MPa = calibrated_E(b.calibration_file.empty() ? default_calibration_file(model_level_of(scene)) : b.calibration_file);
   std::vector<std::string> settings;
   for (const auto& item : b.settings.items()) settings.push_back(item.key() + "=" + setting_text(item.value()));
   MultiBevelAngles angles;
