@@ -24,29 +24,24 @@ done
 ./build/bench/bench_spg | tee out/bench_spg.txt
 ./build/bench/bench_needle | tee out/bench_needle.txt
 ./build/bench/bench_insertion | tee out/bench_insertion.txt
-# Speed against error of the fast model level, SB and AMB 10 mm into the bench scene, against the stored reference
-# (a few minutes; the full and projection levels' runs, about 20 and 7 min a needle, are stored in
+# Speed against error of the fast model level (the default), SB and AMB 10 mm into the bench scene, against the stored
+# reference (under a minute; the full and projection levels' runs, about 20 and 7 min a needle, are stored in
 # docs/notebook/paper_results/bench_insertion_10mm/: `needle bench insertion --out DIR` runs all three).
 ./build/apps/needle bench insertion --levels fast --out out/bench_levels --quiet
 cat out/bench_levels/speed_error.csv
-# The paper reproduced: SB, LMB, AMB and HMB on the paper's scene with the tissue E calibrated on SB
-# (data/paper/calibration_sb.json, made by `needle calibrate`; docs/paper.md), about 20–40 minutes a needle
-# on 2 cores. A run the solver stops is reported as such in the report, not an error of the main job.
-# The report sets six other models beside it, from their stored reports in docs/notebook/paper_results/: the
-# contact's former default (skin 0.04 mm, factor 10), skin 0.02 mm at factor 10, the groove 5 mm behind
-# the tip point, the tissue law that stiffens as the paper's measured curve, no cut, and the fast model level
-# (the kinematic contact and the implicit needle, at the same E; docs/insertion.md) (docs/paper.md). Two replicas
-# of the default model, its runs repeated with the particle lattice shifted 0.1 and 0.05 mm against the needle's path
-# (docs/notebook/scripts/scatter_study.sh), give each deflection's run-to-run scatter and the targets that hold in every replica.
-./build/apps/needle paper --calibration data/paper/calibration_sb.json --out out/paper --label "cut, 0.2 mm near the path, skin 0.02 mm" \
-  --compare "skin 0.04 mm, factor 10 (the default before), E 0.0748=docs/notebook/paper_results/skin0.04_k10/results.json" \
-  --compare "skin 0.02 mm, factor 10, calibrated (E 0.080)=docs/notebook/paper_results/skin0.02_calibrated/results.json" \
-  --compare "groove 5 mm behind A, skin 0.04 mm, calibrated (E 0.0493)=docs/notebook/paper_results/groove5_calibrated/results.json" \
-  --compare "stiffening law, skin 0.04 mm, calibrated on SB=docs/notebook/paper_results/stiffening_calibrated/results.json" \
-  --compare "no cut, skin 0.04 mm, E 0.0748=docs/notebook/paper_results/no_cut/results.json" \
-  --compare "the fast model (--model fast), E 0.078=docs/notebook/paper_results/fast_model/results.json" \
-  --replica "lattice +0.1 mm=docs/notebook/paper_results/lattice_shift_0.1mm/results.json" \
-  --replica "lattice +0.05 mm=docs/notebook/paper_results/lattice_shift_0.05mm/results.json"
+# The paper reproduced: SB, LMB, AMB and HMB on the paper's scene at the default (fast) model level, with the tissue E
+# calibrated on SB at that level (data/paper/calibration_sb.json, made by `needle calibrate`; docs/paper.md), about
+# 1.5–2 minutes a needle on 2 cores. A run the solver stops is reported as such in the report, not an error of the main job.
+# The report sets beside it, from their stored reports in docs/notebook/paper_results/: the full model (the default
+# before, calibrated on SB with itself, E 0.078; `--model full`, 21–23 min a needle) and the fast level before its
+# ellipsoidal supports (at the full model's E). Two replicas of the default model, its runs repeated with the particle
+# lattice shifted 0.1 and 0.05 mm against the needle's path (docs/notebook/scripts/scatter_study.sh), give each
+# deflection's run-to-run scatter and the targets that hold in every replica.
+./build/apps/needle paper --calibration data/paper/calibration_sb.json --out out/paper --label "the fast model (default), calibrated on SB" \
+  --compare "the full model (the default before), E 0.078=docs/notebook/paper_results/full_model/results.json" \
+  --compare "the fast model with spherical supports, E 0.078=docs/notebook/paper_results/fast_model/results.json" \
+  --replica "lattice +0.1 mm=docs/notebook/paper_results/fast_lattice_shift_0.1mm/results.json" \
+  --replica "lattice +0.05 mm=docs/notebook/paper_results/fast_lattice_shift_0.05mm/results.json"
 echo "results in out/: <preset>.json (report), <preset>.stl, <preset>_half.glb, <preset>.png,"
 echo "  <preset>_half_t10.msh/.vtu + <preset>_mesh.json (T10 mesh and its report), tissue_particles.vtp/.json,"
 echo "  material_test.csv/.png/.json (the tissue card in uniaxial tension), stiffness_<preset>.json (tip compliance"

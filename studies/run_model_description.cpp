@@ -72,13 +72,18 @@ std::string describe_run_model(const json& scene, long particles) {
         scene.contains("needle") && scene["needle"].is_object() ? scene["needle"].value("model", std::string("fe")) : std::string("fe");
     const json solver = scene.value("solver", json::object());
     const bool mass_scaled = solver.value("tissue_mass_scaling", false) || solver.value("tissue_mass_scaling_dt_ms", 0.0) > 0;
+    // Spherical kernel supports (the full model's) go unnamed; ellipsoids are said.
+    const bool ellipsoids = t.contains("spg") && t["spg"].is_object() && t["spg"].value("support", std::string("sphere")) == "ellipsoid";
     if (law != "penalty" || (needle_model != "fe" && needle_model != "rigid"))
-      d += fmt::format("; the {} needle and the {} contact{}{}", needle_model == "implicit" ? "implicit linear" : needle_model,
+      d += fmt::format("; the {} needle and the {} contact{}{}{}", needle_model == "implicit" ? "implicit linear" : needle_model,
                        law == "projection" ? "kinematic (projection)" : law,
                        mass_scaled ? ", the tissue mass-scaled to the needle's step" : "",
-                       needle_model == "implicit" && law == "projection" && mass_scaled ? " (--model fast)" : "");
-    else if (mass_scaled)
-      d += "; the tissue mass-scaled to the needle's step";
+                       ellipsoids ? ", ellipsoidal kernel supports" : "",
+                       needle_model == "implicit" && law == "projection" && mass_scaled && ellipsoids ? " (--model fast)" : "");
+    else if (mass_scaled || ellipsoids)
+      d += fmt::format("; {}", mass_scaled && ellipsoids ? "the tissue mass-scaled to the needle's step, ellipsoidal kernel supports"
+                                   : mass_scaled    ? "the tissue mass-scaled to the needle's step"
+                                                    : "ellipsoidal kernel supports");
     // No cutting resistance is the default and goes unnamed; a resistance is said.
     const double cutting_MPa = contact.value("cutting_pressure_MPa", 0.0);
     if (cutting_MPa > 0)

@@ -156,7 +156,8 @@ TEST_CASE("needle paper --report-only names the tissue law, the relaxation, the 
                           {"contact", {{"cuts_bonds", true}, {"slit_half_height_mm", 1.0}, {"crack_reach_mm", 1.2},
                                        {"crack_angles_deg", {0.0, -45.0}}, {"crack_lead_mm", 0.5}, {"cutting_pressure_MPa", 0.3}, {"skin_mm", 0.04},
                                        {"stiffness_factor", 10.0}, {"law", "projection"}}},
-                          {"material", {{"law", "stiffening_elastic"}, {"relaxing_shear_fraction", 0.5}, {"relaxation_time_ms", 0.2}}}}},
+                          {"material", {{"law", "stiffening_elastic"}, {"relaxing_shear_fraction", 0.5}, {"relaxation_time_ms", 0.2}}},
+                          {"spg", {{"support", "ellipsoid"}}}}},
                         {"motion", {{"speed_m_per_s", 4.0}}},
                         {"solver", {{"tissue_mass_scaling", true}}},
                         {"needle", {{"groove_start_mm", 5.0}, {"model", "implicit"}}}};
@@ -173,7 +174,7 @@ TEST_CASE("needle paper --report-only names the tissue law, the relaxation, the 
                                           "(0: horizontal), 1.2 mm long, running 0.5 mm ahead of the tip; "
                                           "the contact's skin is 0.04 mm and its stiffness factor 10 (the defaults: 0.02 and 30); "
                                           "the implicit linear needle and the kinematic (projection) contact, the tissue mass-scaled to the "
-                                          "needle's step (--model fast); "
+                                          "needle's step, ellipsoidal kernel supports (--model fast); "
                                           "cutting the tissue costs work: a pressure of 0.3 MPa on the tip facets that advance into it; "
                                           "the block's entry face is 0.1 mm ahead of the tip's start (the particle lattice shifted against the "
                                           "path; the tip ends that much less deep); the needle is driven at 4 m/s (the paper's model: 8); the groove starts 5 mm behind the tip point (the presets': 3)") !=
