@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
+#include <optional>
 #include <vector>
 
 #include "core/input_error.h"
@@ -48,6 +49,9 @@ std::vector<double> local_spacing(const std::vector<double>& nodes) {
   return spacing;
 }
 
+// The flags of a particle at x from the box faces it lies on.
+std::uint8_t face_flags(const TissueBox& box, const Eigen::Vector3d& x, double tolerance);
+
 std::uint8_t flag_of(FaceCondition c) {
   switch (c) {
     case FaceCondition::fixed: return kParticleFixed;
@@ -57,7 +61,101 @@ std::uint8_t flag_of(FaceCondition c) {
   return 0;
 }
 
+std::uint8_t face_flags(const TissueBox& box, const Eigen::Vector3d& x, double tolerance) {
+  std::uint8_t flags = 0;
+  for (int k = 0; k < 3; ++k) {
+    if (std::abs(x[k] - box.min_mm[k]) <= tolerance) flags |= flag_of(box.faces[static_cast<size_t>(2 * k)]);
+    if (std::abs(x[k] - box.max_mm[k]) <= tolerance) flags |= flag_of(box.faces[static_cast<size_t>(2 * k + 1)]);
+  }
+  return flags;
+}
+
+// The nested lattice (LatticeGrading::nested): the fine nodes of the tensor lattice within the region's range on
+// every axis, and the coarse nodes outside that closed box.
+ParticleSet nested_lattice(const TissueBox& box, double h, const RegionOfInterest& roi) {
+  std::vector<double> coarse[3], coarse_dual[3], coarse_spacing[3], fine[3], fine_dual[3], fine_spacing[3];
+  double lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) {
+    coarse[k] = axis_nodes(box.min_mm[k], box.max_mm[k], h, std::nullopt, 1);
+    coarse_dual[k] = dual_lengths(coarse[k]);
+    coarse_spacing[k] = local_spacing(coarse[k]);
+    const double step = coarse[k][1] - coarse[k][0], tolerance = 1e-9 * step;
+    // The region's range snapped outward to coarse nodes: the coarse intervals that overlap it.
+    lo[k] = coarse[k].back();
+    hi[k] = coarse[k].front();
+    for (size_t i = 0; i + 1 < coarse[k].size(); ++i)
+      if (coarse[k][i + 1] > roi.min_mm[k] + tolerance && coarse[k][i] < roi.max_mm[k] - tolerance) {
+        lo[k] = std::min(lo[k], coarse[k][i]);
+        hi[k] = std::max(hi[k], coarse[k][i + 1]);
+      }
+    for (double x : axis_nodes(box.min_mm[k], box.max_mm[k], h, std::array<double, 2>{roi.min_mm[k], roi.max_mm[k]}, roi.refinement))
+      if (x >= lo[k] - tolerance && x <= hi[k] + tolerance) fine[k].push_back(x);
+    fine_dual[k] = dual_lengths(fine[k]);
+    fine_spacing[k] = local_spacing(fine[k]);
+    // A face of the region inside the box: its fine nodes' cells reach half a coarse interval out (the coarse
+    // cells there are gone with the coarse nodes on the face), and their nearest neighbour out is a coarse node.
+    const double coarse_step = step;
+    if (lo[k] > box.min_mm[k] + tolerance) {
+      fine_dual[k].front() += 0.5 * coarse_step;
+      fine_spacing[k].front() = std::max(fine_spacing[k].front(), coarse_step);
+    }
+    if (hi[k] < box.max_mm[k] - tolerance) {
+      fine_dual[k].back() += 0.5 * coarse_step;
+      fine_spacing[k].back() = std::max(fine_spacing[k].back(), coarse_step);
+    }
+  }
+  const auto inside_region = [&](const Eigen::Vector3d& x) {
+    for (int k = 0; k < 3; ++k) {
+      const double tolerance = 1e-9 * h;
+      if (x[k] < lo[k] - tolerance || x[k] > hi[k] + tolerance) return false;
+    }
+    return true;
+  };
+  std::vector<Eigen::Vector3d> x, axis_spacing;
+  std::vector<double> volume;
+  for (size_t a = 0; a < fine[0].size(); ++a)
+    for (size_t b = 0; b < fine[1].size(); ++b)
+      for (size_t c = 0; c < fine[2].size(); ++c) {
+        x.emplace_back(fine[0][a], fine[1][b], fine[2][c]);
+        volume.push_back(fine_dual[0][a] * fine_dual[1][b] * fine_dual[2][c]);
+        axis_spacing.emplace_back(fine_spacing[0][a], fine_spacing[1][b], fine_spacing[2][c]);
+      }
+  for (size_t a = 0; a < coarse[0].size(); ++a)
+    for (size_t b = 0; b < coarse[1].size(); ++b)
+      for (size_t c = 0; c < coarse[2].size(); ++c) {
+        const Eigen::Vector3d p(coarse[0][a], coarse[1][b], coarse[2][c]);
+        if (inside_region(p)) continue;
+        x.push_back(p);
+        volume.push_back(coarse_dual[0][a] * coarse_dual[1][b] * coarse_dual[2][c]);
+        axis_spacing.emplace_back(coarse_spacing[0][a], coarse_spacing[1][b], coarse_spacing[2][c]);
+      }
+  const Eigen::Index n = static_cast<Eigen::Index>(x.size());
+  ParticleSet p;
+  p.x_mm.resize(n, 3);
+  p.volume_mm3.resize(n);
+  p.spacing_mm.resize(n);
+  p.axis_spacing_mm.resize(n, 3);
+  p.flags.resize(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const size_t s = static_cast<size_t>(i);
+    p.x_mm.row(i) = x[s].transpose();
+    p.volume_mm3[i] = volume[s];
+    p.axis_spacing_mm.row(i) = axis_spacing[s].transpose();
+    p.spacing_mm[i] = axis_spacing[s].maxCoeff();
+    p.flags[i] = face_flags(box, x[s], 1e-9 * h);
+  }
+  return p;
+}
+
 }  // namespace
+
+LatticeGrading lattice_grading_from_name(const std::string& name) {
+  if (name == "tensor") return LatticeGrading::tensor;
+  if (name == "nested") return LatticeGrading::nested;
+  throw InputError(fmt::format("lattice grading '{}' is not one of tensor, nested", name));
+}
+
+std::string lattice_grading_name(LatticeGrading grading) { return grading == LatticeGrading::nested ? "nested" : "tensor"; }
 
 FaceCondition face_condition_from_name(const std::string& name) {
   if (name == "free") return FaceCondition::free;
@@ -98,6 +196,8 @@ ParticleSet make_particle_lattice(const TissueBox& box, const LatticeOptions& op
   for (int k = 0; k < 3; ++k) estimate *= (box.max_mm[k] - box.min_mm[k]) / h * refinement + 1;
   NEEDLE_REQUIRE(estimate < 5e7, fmt::format("spacing {} mm would make about {:.3g} particles (limit 5e7)", h, estimate));
 
+  if (options.region_of_interest && options.region_of_interest->grading == LatticeGrading::nested && refinement > 1)
+    return nested_lattice(box, h, *options.region_of_interest);
   std::vector<double> nodes[3], dual[3], spacing[3];
   for (int k = 0; k < 3; ++k) {
     std::optional<std::array<double, 2>> roi;

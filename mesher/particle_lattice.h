@@ -4,7 +4,7 @@
 //
 // The lattice is a tensor product: along each axis the box is split into equal intervals of about
 // spacing_mm (the count is rounded, the effective spacing reported), and an optional region of
-// interest is split `refinement` times finer. Particles sit on the lattice nodes, so the faces
+// interest is split `refinement` times finer (through the whole box, or nested: LatticeGrading). Particles sit on the lattice nodes, so the faces
 // (fixed faces, the symmetry plane) carry particles, as the nodes of a hexahedral mesh would.
 // A particle's volume is the product of its half-interval lengths; the volumes sum to the box
 // volume exactly.
@@ -32,9 +32,21 @@ struct TissueBox {
                                      FaceCondition::fixed, FaceCondition::symmetry, FaceCondition::fixed};
 };
 
+// How the region of interest is refined:
+//  - tensor: each axis's intervals within the region's range are split, through the whole box (the fine x
+//    intervals of a region spanning the block's length reach every particle of the block);
+//  - nested: the region alone holds the fine lattice; outside it the coarse lattice stays coarse along every
+//    axis. The coarse nodes on the region's closed box are the fine ones there; the fine dual cells on a face of
+//    the region inside the box reach half a coarse interval out, so that the volumes still sum to the box's.
+enum class LatticeGrading { tensor, nested };
+
+LatticeGrading lattice_grading_from_name(const std::string& name);  // "tensor", "nested"; InputError otherwise
+std::string lattice_grading_name(LatticeGrading grading);
+
 struct RegionOfInterest {
   Eigen::Vector3d min_mm, max_mm;  // snapped outward to the coarse lattice
   int refinement = 2;              // fine spacing = spacing / refinement
+  LatticeGrading grading = LatticeGrading::tensor;
 };
 
 struct LatticeOptions {
@@ -49,7 +61,7 @@ struct ParticleSet {
   Eigen::MatrixX3d axis_spacing_mm;                     // #P by 3: the largest neighbouring interval along each axis
                                                         // (sets an ellipsoidal support; may be empty for other sets)
   Eigen::Matrix<std::uint8_t, Eigen::Dynamic, 1> flags;  // #P ParticleFlag bits
-  Eigen::Vector3i nodes_per_axis{0, 0, 0};
+  Eigen::Vector3i nodes_per_axis{0, 0, 0};                // a tensor lattice's node counts (0 for a nested one)
   int num_particles() const { return static_cast<int>(x_mm.rows()); }
 };
 

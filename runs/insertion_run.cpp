@@ -43,7 +43,8 @@ ParticleSet scene_particles(const Scene& scene) {
     const double w = t.path_half_width_mm;
     NEEDLE_REQUIRE(w < 0.5 * t.size_mm.y() && w < t.size_mm.z(),
                    fmt::format("tissue: path_half_width_mm {} mm reaches the block's faces", w));
-    lattice.region_of_interest = RegionOfInterest{{box.min_mm.x(), -w, half ? 0.0 : -w}, {box.max_mm.x(), w, w}, t.path_refinement};
+    lattice.region_of_interest =
+        RegionOfInterest{{box.min_mm.x(), -w, half ? 0.0 : -w}, {box.max_mm.x(), w, w}, t.path_refinement, t.path_grading};
   }
   return make_particle_lattice(box, lattice);
 }

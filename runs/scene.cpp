@@ -108,6 +108,14 @@ void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc) {
   t.spacing_mm = o.quantity("spacing", Dimension::length, t.spacing_mm, positive());
   t.path_refinement = o.integer("path_refinement", t.path_refinement, 1, 8);
   t.path_half_width_mm = o.quantity("path_half_width", Dimension::length, t.path_half_width_mm, positive());
+  {
+    const std::string grading = o.text("path_grading", lattice_grading_name(t.path_grading));
+    try {
+      t.path_grading = lattice_grading_from_name(grading);
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("{}: {}", o.where("path_grading"), e.what()));
+    }
+  }
   t.dilation = o.number("dilation", t.dilation, within(1.0, 4.0));
   t.spg.dilation = t.dilation;
   t.friction = o.number("friction", t.friction, non_negative());
@@ -230,6 +238,7 @@ json scene_to_json(const Scene& s) {
   json tissue = {
       {"enabled", t.enabled}, {"size_mm", vector_json(t.size_mm)}, {"entry_x_mm", t.entry_x_mm}, {"spacing_mm", t.spacing_mm},
       {"path_refinement", t.path_refinement}, {"path_half_width_mm", t.path_half_width_mm},
+      {"path_grading", lattice_grading_name(t.path_grading)},
       {"dilation", t.dilation}, {"friction", t.friction}, {"material", material_to_json(t.material)},
       {"spg", {{"support", support_shape_name(t.spg.support)},
                {"kernel_update", kernel_update_name(t.spg.kernel_update)},

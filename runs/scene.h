@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "mesher/needle_mesher.h"
+#include "mesher/particle_lattice.h"
 #include "solver/needle/insertion_profile.h"
 #include "solver/insertion/coupled_insertion.h"
 #include "solver/separation/separation_models.h"
@@ -54,6 +55,9 @@ struct TissueScene {
   // particles put one particle row on LMB's bottom bevel.
   int path_refinement = 1;
   double path_half_width_mm = 1.2;
+  // tensor: the fine x intervals run through the whole block (the reference); nested: only the band around the path
+  // is fine, the rest coarse along every axis (mesher/particle_lattice.h: LatticeGrading).
+  LatticeGrading path_grading = LatticeGrading::tensor;
   TissueMaterial material;
   SpgOptions spg;                           // kernel, stabilization, bond failure, cfl (docs/solver.md)
   ContactOptions contact;                   // friction copied from `friction`
