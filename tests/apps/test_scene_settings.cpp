@@ -72,7 +72,7 @@ TEST_CASE("needle run --set and needle simulate --set change the run's scene; a 
   CHECK(nlohmann::json::parse(summary_file)["insertion_mm"].get<double>() == Approx(0.3).epsilon(1e-9));
 }
 
-TEST_CASE("needle run with no E given takes the shipped SB calibration's and says so", "[apps][lspg][gmsh][slow]") {
+TEST_CASE("needle run with no E given takes the shipped SB calibration of its model level and says so", "[apps][lspg][gmsh][slow]") {
   // The run defaults, shrunk with --set to seconds: a short T4 SB, a small block, 0.8 mm.
   const fs::path dir = fresh_folder("calibrated_default");
   const std::string shrink =
@@ -87,6 +87,23 @@ TEST_CASE("needle run with no E given takes the shipped SB calibration's and say
   CHECK(nlohmann::json::parse(scene)["tissue"]["material"]["E_MPa"].get<double>() == calibrated_E);
   CHECK(r.out.find("calibrated on SB: ") != std::string::npos);
   CHECK(r.out.find("data/paper/calibration_sb.json") != std::string::npos);
+  std::ifstream default_scene(dir / "run" / "scene.json");
+  const nlohmann::json run_scene = nlohmann::json::parse(default_scene);
+  CHECK(run_scene["needle"]["model"] == "implicit");  // the run defaults are the fast level
+  CHECK(run_scene["tissue"]["spg"]["support"] == "ellipsoid");
+
+  // The full model takes the full model's own calibration (another E), the fast level by name the default's.
+  const auto full = run("run --preset SB --model full --out " + (dir / "full").string() + shrink, true);
+  INFO(full.out);
+  REQUIRE(full.exit_code == 0);
+  std::ifstream full_calibration(fs::path(NEEDLE_SOURCE_DIR) / "data/paper/calibration_sb_full.json"), full_scene(dir / "full" / "scene.json");
+  const double full_E = nlohmann::json::parse(full_calibration)["tissue_E_MPa"].get<double>();
+  CHECK(full_E != calibrated_E);
+  const nlohmann::json full_run_scene = nlohmann::json::parse(full_scene);
+  CHECK(full_run_scene["tissue"]["material"]["E_MPa"].get<double>() == full_E);
+  CHECK(full_run_scene["needle"].value("model", std::string("fe")) == "fe");  // the FE needle is written by leaving the key out
+  CHECK(full_run_scene["tissue"]["spg"]["support"] == "sphere");
+  CHECK(full.out.find("data/paper/calibration_sb_full.json") != std::string::npos);
 
   // --tissue-E-MPa and --set override it, and say so.
   const auto given = run("run --preset SB --tissue-E-MPa 0.2 --out " + (dir / "given").string() + shrink, true);
