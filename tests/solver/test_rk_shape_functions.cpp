@@ -168,15 +168,15 @@ TEST_CASE("The transpose's copy of the values follows every rebuilt and cleared 
 namespace {
 
 // A lattice graded as the run's is: 0.2 mm intervals along x everywhere and in a band around the path,
-// 0.4 mm across y and z outside it.
-ParticleSet graded_lattice() {
+// 0.4 mm across y and z outside it (tensor), or 0.4 mm along every axis outside the band (nested).
+ParticleSet graded_lattice(LatticeGrading grading = LatticeGrading::tensor) {
   TissueBox box;
   box.min_mm = {0, -1.6, 0};
   box.max_mm = {2.4, 1.6, 1.6};
   box.faces.fill(FaceCondition::free);
   LatticeOptions o;
   o.spacing_mm = 0.4;
-  o.region_of_interest = RegionOfInterest{{0, -0.4, 0}, {2.4, 0.4, 0.4}, 2};
+  o.region_of_interest = RegionOfInterest{{0, -0.4, 0}, {2.4, 0.4, 0.4}, 2, grading};
   return make_particle_lattice(box, o);
 }
 
@@ -250,14 +250,7 @@ TEST_CASE("On a uniform lattice ellipsoidal supports are the spheres", "[solver]
 }
 
 TEST_CASE("On a nested lattice every row is valid and reproduces linear fields, with either support", "[solver][rk]") {
-  TissueBox box;
-  box.min_mm = {0, -1.6, 0};
-  box.max_mm = {2.4, 1.6, 1.6};
-  box.faces.fill(FaceCondition::free);
-  LatticeOptions o;
-  o.spacing_mm = 0.4;
-  o.region_of_interest = RegionOfInterest{{0, -0.4, 0}, {2.4, 0.4, 0.4}, 2, LatticeGrading::nested};
-  const ParticleSet set = make_particle_lattice(box, o);
+  const ParticleSet set = graded_lattice(LatticeGrading::nested);
   for (const KernelSupports& supports : {KernelSupports(Eigen::VectorXd(1.8 * set.spacing_mm)), KernelSupports::ellipsoids(1.8 * set.axis_spacing_mm)}) {
     const RkShapeFunctions rk = build_rk_shape_functions(set.x_mm, supports);
     const Worst w = check_rows(rk, set.x_mm, set.x_mm);  // requires every row valid
