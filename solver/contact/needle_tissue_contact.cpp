@@ -50,18 +50,18 @@ void NeedleTissueContact::build_node_grid(const Eigen::MatrixX3d& x) {
   node_origin_ = box_lo_.array() - 2 * node_cell_mm_;
   // A dense grid (the needle's box and two cells around it), each cell's nodes in increasing order: a counting
   // sort over the nodes, which the search then reads cell by cell.
-  std::vector<int> cell(nodes.size());
-  node_grid_dims_ = Eigen::Vector3i::Zero();
-  for (size_t k = 0; k < nodes.size(); ++k) {
-    const Eigen::Vector3i c = ((x.row(nodes[k]).transpose() - node_origin_) / node_cell_mm_).array().floor().cast<int>();
-    node_grid_dims_ = node_grid_dims_.cwiseMax(c + Eigen::Vector3i::Constant(3));
-  }
-  const auto index = [this](const Eigen::Vector3i& c) { return (c.z() * node_grid_dims_.y() + c.y()) * node_grid_dims_.x() + c.x(); };
-  node_cell_start_.assign(static_cast<size_t>(node_grid_dims_.prod()) + 1, 0);
   std::vector<int> order(nodes.begin(), nodes.end());
   std::sort(order.begin(), order.end());
+  std::vector<Eigen::Vector3i> cells(order.size());
+  node_grid_dims_ = Eigen::Vector3i::Zero();
   for (size_t k = 0; k < order.size(); ++k) {
-    cell[k] = index(((x.row(order[k]).transpose() - node_origin_) / node_cell_mm_).array().floor().cast<int>());
+    cells[k] = ((x.row(order[k]).transpose() - node_origin_) / node_cell_mm_).array().floor().cast<int>();
+    node_grid_dims_ = node_grid_dims_.cwiseMax(cells[k] + Eigen::Vector3i::Constant(3));
+  }
+  node_cell_start_.assign(static_cast<size_t>(node_grid_dims_.prod()) + 1, 0);
+  std::vector<int> cell(order.size());
+  for (size_t k = 0; k < order.size(); ++k) {
+    cell[k] = (cells[k].z() * node_grid_dims_.y() + cells[k].y()) * node_grid_dims_.x() + cells[k].x();
     ++node_cell_start_[static_cast<size_t>(cell[k]) + 1];
   }
   for (size_t c = 1; c < node_cell_start_.size(); ++c) node_cell_start_[c] += node_cell_start_[c - 1];

@@ -6,12 +6,26 @@ namespace needle {
 
 double TissueMaterial::yield_strain() const { return std::pow(E_MPa / k_MPa, 1.0 / (n - 1.0)); }
 
+namespace {
+
+// The rate law in logarithms: factor = 1 + exp(log_term), capped where log_term reaches log_cap. The one place
+// rate_factor and rate_factor_uncapped_up_to take them from (rate > 0, the law on).
+struct RateLogs {
+  double log_term, log_cap;
+};
+
+RateLogs rate_logs(const TissueMaterial& m, double strain_rate_per_ms) {
+  const double exponent = m.rate_law == RateLaw::printed ? 1.0 / m.rate_p : m.rate_p;
+  return {exponent * std::log(strain_rate_per_ms / m.rate_C_per_ms),
+          std::log(m.max_rate_factor - 1.0 > 0 ? m.max_rate_factor - 1.0 : 1e-300)};
+}
+
+}  // namespace
+
 double TissueMaterial::rate_factor(double strain_rate_per_ms, bool* capped) const {
   if (capped) *capped = false;
   if (rate_law == RateLaw::off || !(strain_rate_per_ms > 0)) return 1.0;
-  const double exponent = rate_law == RateLaw::printed ? 1.0 / rate_p : rate_p;
-  const double log_term = exponent * std::log(strain_rate_per_ms / rate_C_per_ms);
-  const double log_cap = std::log(max_rate_factor - 1.0 > 0 ? max_rate_factor - 1.0 : 1e-300);
+  const auto [log_term, log_cap] = rate_logs(*this, strain_rate_per_ms);
   if (log_term >= log_cap) {
     if (capped) *capped = true;
     return max_rate_factor;
@@ -30,10 +44,8 @@ double TissueMaterial::hardening_slope_MPa(double plastic_strain, double factor)
 bool TissueMaterial::rate_factor_uncapped_up_to(double strain_rate_per_ms) const {
   if (rate_law == RateLaw::off || !(strain_rate_per_ms > 0)) return true;
   if (!std::isfinite(strain_rate_per_ms)) return false;
-  const double exponent = rate_law == RateLaw::printed ? 1.0 / rate_p : rate_p;
-  const double log_term = exponent * std::log(strain_rate_per_ms / rate_C_per_ms);  // rises with the rate
-  const double log_cap = std::log(max_rate_factor - 1.0 > 0 ? max_rate_factor - 1.0 : 1e-300);
-  return log_term < log_cap - 1e-9 * (1 + std::abs(log_cap));
+  const RateLogs logs = rate_logs(*this, strain_rate_per_ms);  // log_term rises with the rate
+  return logs.log_term < logs.log_cap - 1e-9 * (1 + std::abs(logs.log_cap));
 }
 
 Eigen::Vector3d mat018_deviatoric_stress(const TissueMaterial& m, const IncrementStrainRate& rate, const Eigen::Vector3d& h_dev,
