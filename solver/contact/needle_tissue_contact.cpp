@@ -4,6 +4,7 @@
 #include <cmath>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+#include <tuple>
 
 #include "core/input_error.h"
 #include "core/parallel.h"
@@ -48,8 +49,8 @@ void NeedleTissueContact::build_node_grid(const Eigen::MatrixX3d& x) {
     box_hi_ = box_hi_.cwiseMax(x.row(n).transpose());
   }
   node_origin_ = box_lo_.array() - 2 * node_cell_mm_;
-  // A dense grid (the needle's box and two cells around it), each cell's nodes in increasing order: a counting
-  // sort over the nodes, which the search then reads cell by cell.
+  // A dense grid (the needle's box and two cells around it), each cell's nodes in increasing order with their
+  // positions beside them: a counting sort over the nodes, which the search then reads cell by cell.
   std::vector<int> order(nodes.begin(), nodes.end());
   std::sort(order.begin(), order.end());
   std::vector<Eigen::Vector3i> cells(order.size());
@@ -66,29 +67,51 @@ void NeedleTissueContact::build_node_grid(const Eigen::MatrixX3d& x) {
   }
   for (size_t c = 1; c < node_cell_start_.size(); ++c) node_cell_start_[c] += node_cell_start_[c - 1];
   node_cell_nodes_.resize(order.size());
+  node_cell_points_.resize(order.size());
   std::vector<int> fill(node_cell_start_.begin(), node_cell_start_.end() - 1);
-  for (size_t k = 0; k < order.size(); ++k) node_cell_nodes_[static_cast<size_t>(fill[static_cast<size_t>(cell[k])]++)] = order[k];
+  for (size_t k = 0; k < order.size(); ++k) {
+    const size_t e = static_cast<size_t>(fill[static_cast<size_t>(cell[k])]++);
+    node_cell_nodes_[e] = order[k];
+    node_cell_points_[e] = x.row(order[k]).transpose();
+  }
 }
 
-int NeedleTissueContact::nearest_surface_node(const Eigen::Vector3d& p, const Eigen::MatrixX3d& x) const {
-  const Eigen::Vector3i c = ((p - node_origin_) / node_cell_mm_).array().floor().cast<int>();
+int NeedleTissueContact::nearest_surface_node(const Eigen::Vector3d& p) const {
+  // The nearest surface node closer than the cell size r (so in the 27 cells around p's). Of equally near nodes
+  // the first in x-major cell order (x, then y, then z) and then in node number wins, as a scan of the 27 cells in
+  // that order finds it. p's own cell is read first and a cell farther from p than the best so far is skipped
+  // (it holds no node as near: the slack is far above the rounding of the cell's bounds).
+  if (!p.allFinite()) return -1;
+  const double r = node_cell_mm_, slack = 1e-9 * r;
+  const Eigen::Vector3i c = ((p - node_origin_) / r).array().floor().cast<int>();
   int best = -1;
-  double best_d2 = node_cell_mm_ * node_cell_mm_;
-  // Cells in x-major order, each cell's nodes in increasing order: of equally near nodes the first wins.
-  for (int i = c.x() - 1; i <= c.x() + 1; ++i)
-    for (int j = c.y() - 1; j <= c.y() + 1; ++j)
-      for (int k = c.z() - 1; k <= c.z() + 1; ++k) {
-        if (i < 0 || j < 0 || k < 0 || i >= node_grid_dims_.x() || j >= node_grid_dims_.y() || k >= node_grid_dims_.z()) continue;
-        const size_t id = static_cast<size_t>((k * node_grid_dims_.y() + j) * node_grid_dims_.x() + i);
-        for (int e = node_cell_start_[id]; e < node_cell_start_[id + 1]; ++e) {
-          const int node = node_cell_nodes_[static_cast<size_t>(e)];
-          const double d2 = (x.row(node).transpose() - p).squaredNorm();
-          if (d2 < best_d2) {
-            best_d2 = d2;
-            best = node;
-          }
-        }
+  Eigen::Vector3i best_cell = Eigen::Vector3i::Zero();
+  double best_d2 = r * r, reach = r + slack;
+  const auto visit = [&](const Eigen::Vector3i& cell) {
+    if ((cell.array() < 0).any() || (cell.array() >= node_grid_dims_.array()).any()) return;
+    const Eigen::Vector3d lo = node_origin_ + r * cell.cast<double>();
+    const Eigen::Vector3d gap = (lo - p).cwiseMax(p - lo - Eigen::Vector3d::Constant(r)).cwiseMax(0.0);
+    if (gap.squaredNorm() > reach * reach) return;
+    const size_t id = static_cast<size_t>((cell.z() * node_grid_dims_.y() + cell.y()) * node_grid_dims_.x() + cell.x());
+    for (int e = node_cell_start_[id]; e < node_cell_start_[id + 1]; ++e) {
+      const double d2 = (node_cell_points_[static_cast<size_t>(e)] - p).squaredNorm();
+      if (d2 > best_d2) continue;
+      const int node = node_cell_nodes_[static_cast<size_t>(e)];
+      const bool earlier = best >= 0 && std::make_tuple(cell.x(), cell.y(), cell.z(), node) <
+                                            std::make_tuple(best_cell.x(), best_cell.y(), best_cell.z(), best);
+      if (d2 < best_d2 || earlier) {
+        best_d2 = d2;
+        best = node;
+        best_cell = cell;
+        reach = std::sqrt(best_d2) + slack;
       }
+    }
+  };
+  visit(c);
+  for (int i = -1; i <= 1; ++i)
+    for (int j = -1; j <= 1; ++j)
+      for (int k = -1; k <= 1; ++k)
+        if (i || j || k) visit(c + Eigen::Vector3i(i, j, k));
   return best;
 }
 
@@ -112,7 +135,7 @@ void NeedleTissueContact::probe(const std::vector<Vec3d>& x, const Eigen::Matrix
       probe = Probe{};
       const Eigen::Vector3d p = x[s];
       if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) continue;
-      const int node = nearest_surface_node(p, needle_x);
+      const int node = nearest_surface_node(p);
       if (node < 0) continue;
       const Eigen::Vector3d X = surface_.pull_back(p, node, needle_x);
       const double phi = level_set.signed_distance_mm(X);
@@ -211,7 +234,7 @@ std::vector<Eigen::Vector3d> NeedleTissueContact::pull_back(const std::vector<Ve
       const size_t s = static_cast<size_t>(i);
       const Eigen::Vector3d p = x[s];
       if ((p.array() < box_lo_.array() - node_cell_mm_).any() || (p.array() > box_hi_.array() + node_cell_mm_).any()) continue;
-      const int node = nearest_surface_node(p, needle_x);
+      const int node = nearest_surface_node(p);
       if (node >= 0) out[s] = surface_.pull_back(p, node, needle_x);
     }
   });

@@ -147,14 +147,16 @@ class NeedleTissueContact : public NeedleLoads {
 
  private:
   void build_node_grid(const Eigen::MatrixX3d& needle_x);
-  int nearest_surface_node(const Eigen::Vector3d& p, const Eigen::MatrixX3d& needle_x) const;
+  int nearest_surface_node(const Eigen::Vector3d& p) const;  // in the grid of the last build_node_grid
 
-  // Grid of the current surface nodes (rebuilt when the needle moves): cells of node_cell_mm_ from node_origin_.
+  // Grid of the current surface nodes (rebuilt when the needle moves): cells of node_cell_mm_ (the search's
+  // radius) from node_origin_, each cell's nodes in increasing order, with their positions beside them.
   double node_cell_mm_ = 0;
   Eigen::Vector3d node_origin_ = Eigen::Vector3d::Zero();
   Eigen::Vector3i node_grid_dims_ = Eigen::Vector3i::Zero();
   std::vector<int> node_cell_start_;  // cell c's surface nodes: node_cell_nodes_[start[c] .. start[c + 1])
   std::vector<int> node_cell_nodes_;
+  std::vector<Eigen::Vector3d> node_cell_points_;  // their positions, in the same order
   Eigen::Vector3d box_lo_ = Eigen::Vector3d::Zero(), box_hi_ = Eigen::Vector3d::Zero();
 };
 

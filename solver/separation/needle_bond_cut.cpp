@@ -7,6 +7,8 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
+#include "core/parallel.h"
+
 namespace needle {
 
 // The needle's current triangles (for a half model with the mirror images of those that touch the
@@ -188,7 +190,23 @@ std::vector<double> NeedleBondCut::surface_crossings(const Eigen::Vector3d& a, c
 std::vector<std::int64_t> NeedleBondCut::bonds_through_needle(const BondNetwork& bonds, const std::vector<Vec3d>& x,
                                                               const Eigen::MatrixX3d& needle_x) const {
   const Grid grid = build_grid(needle_x);
+  // Each particle's side of the grid's box along each axis (bit 2k: below it on axis k, bit 2k + 1: above), once
+  // a step: a segment whose two ends share a bit lies wholly on that side, which is for_each_hit's first test
+  // (so the same bonds are found). Most bonds of the block are so, and are then rejected without their positions.
+  std::vector<std::uint8_t> side(x.size());
+  parallel_for(static_cast<std::int64_t>(x.size()), [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t i = begin; i < end; ++i) {
+      const Vec3d& p = x[static_cast<size_t>(i)];
+      std::uint8_t bits = 0;
+      for (int k = 0; k < 3; ++k) {
+        if (p[k] < grid.lo[k]) bits |= static_cast<std::uint8_t>(1 << (2 * k));
+        if (p[k] > grid.hi[k]) bits |= static_cast<std::uint8_t>(2 << (2 * k));
+      }
+      side[static_cast<size_t>(i)] = bits;
+    }
+  });
   return select_intact_bonds(bonds, [&](std::int32_t i, std::int32_t j) {
+    if (side[static_cast<size_t>(i)] & side[static_cast<size_t>(j)]) return false;
     return passes_through(grid, x[static_cast<size_t>(i)], x[static_cast<size_t>(j)]);
   });
 }
