@@ -5,6 +5,8 @@
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+#include <tbb/task_group.h>
 
 namespace needle {
 
@@ -17,6 +19,13 @@ void parallel_for(std::int64_t n, const std::function<void(std::int64_t, std::in
   }
   tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, n, kGrain),
                     [&](const tbb::blocked_range<std::int64_t>& r) { body(r.begin(), r.end()); });
+}
+
+void run_beside(const std::function<void()>& serial, const std::function<void()>& beside) {
+  tbb::task_group group;
+  group.run([&beside] { beside(); });
+  tbb::this_task_arena::isolate([&serial] { serial(); });
+  group.wait();
 }
 
 struct ThreadLimit::Impl {

@@ -33,6 +33,12 @@ std::vector<T> parallel_collect(std::int64_t n, const Body& body) {
   return out;
 }
 
+// Runs serial() on the calling thread while beside() runs on the other worker threads (its own parallel_for
+// chunks may be helped by the caller once serial() is done), and returns when both are done. serial() keeps
+// its thread: it does not pick up beside()'s work midway. Each keeps its own results' independence of the
+// schedule, so the pair does too.
+void run_beside(const std::function<void()>& serial, const std::function<void()>& beside);
+
 // Limits the worker threads for the lifetime of the object (0 = all cores).
 class ThreadLimit {
  public:

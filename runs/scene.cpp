@@ -183,6 +183,8 @@ void read_solver(SceneObject o, SolverScene& s) {
   c.contact_courant = o.number("contact_courant", c.contact_courant, within(1e-3, 1.0));
   c.max_energy_error = s.max_energy_error;
   c.max_depth_mm = o.quantity("max_contact_depth", Dimension::length, c.max_depth_mm, positive());
+  c.tissue_beside_needle = o.boolean("tissue_beside_needle", c.tissue_beside_needle);
+  c.tissue_ahead_margin_mm = o.quantity("tissue_ahead_margin", Dimension::length, c.tissue_ahead_margin_mm, non_negative());
   o.finish();
 }
 
@@ -281,6 +283,11 @@ json scene_to_json(const Scene& s) {
   if (s.needle.model == "implicit") solver["implicit_needle_step_ms"] = s.solver.implicit_needle_step_ms;
   if (s.solver.tissue_mass_scaling) solver["tissue_mass_scaling"] = true;
   if (s.solver.tissue_mass_scaling_dt_ms > 0) solver["tissue_mass_scaling_dt_ms"] = s.solver.tissue_mass_scaling_dt_ms;
+  // Written only when not the default (the same results either way: a matter of speed).
+  const CouplingOptions defaults;
+  if (s.solver.coupling.tissue_beside_needle != defaults.tissue_beside_needle) solver["tissue_beside_needle"] = s.solver.coupling.tissue_beside_needle;
+  if (s.solver.coupling.tissue_ahead_margin_mm != defaults.tissue_ahead_margin_mm)
+    solver["tissue_ahead_margin_mm"] = s.solver.coupling.tissue_ahead_margin_mm;
   return {
       {"needle", needle},
       {"motion", motion},

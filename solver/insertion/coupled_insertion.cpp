@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "core/input_error.h"
+#include "core/parallel.h"
 #include "core/solver_error.h"
 #include "solver/contact/contact_laws.h"
 
@@ -18,6 +19,8 @@ void CouplingOptions::validate(const std::string& where) const {
   NEEDLE_REQUIRE(std::isfinite(max_depth_mm) && max_depth_mm > 0, fmt::format("{}: max_depth_mm must be positive", where));
   NEEDLE_REQUIRE(std::isfinite(tissue_mass_scaling_dt_ms) && tissue_mass_scaling_dt_ms >= 0,
                  fmt::format("{}: tissue_mass_scaling_dt_ms must be zero or positive", where));
+  NEEDLE_REQUIRE(std::isfinite(tissue_ahead_margin_mm) && tissue_ahead_margin_mm >= 0,
+                 fmt::format("{}: tissue_ahead_margin_mm must be zero or positive", where));
 }
 
 CoupledInsertion::CoupledInsertion(NeedleModel& needle, SpgTissue& tissue, const ContactSurface& surface, const ContactOptions& contact,
@@ -50,7 +53,14 @@ void CoupledInsertion::step(double end_time_ms) {
   const double t = time_ms();
   const double dt = tissue_dynamics_.kick_and_drift(plan_time_step(end_time_ms));
   contact_->begin_step(tissue_.particles(), needle_.positions_mm(), needle_.velocities_mm_per_ms(), t, dt);
-  needle_.advance_to(t + dt, loads_);
+  if (options_.tissue_beside_needle) {
+    mark_particles_away_from_needle();
+    needle_x_before_ = needle_.positions_mm();
+    run_beside([&] { needle_.advance_to(t + dt, loads_); }, [&] { tissue_.update_points_ahead(dt, still_); });
+    needle_motion_mm_ = (needle_.positions_mm() - needle_x_before_).rowwise().norm().maxCoeff();
+  } else {
+    needle_.advance_to(t + dt, loads_);
+  }
   contact_->end_step(tissue_dynamics_, needle_.positions_mm(), needle_.velocities_mm_per_ms(), contact_force_N_);
   tissue_dynamics_.finish_step(&contact_force_N_);
   for (const std::unique_ptr<SeparationModel>& separation : separations_) separation->apply(tissue_, needle_);
@@ -69,6 +79,23 @@ ContactReport CoupledInsertion::contact() const {
   ContactReport report = contact_->report();
   if (cutting_) cutting_->add_to(report);
   return report;
+}
+
+void CoupledInsertion::mark_particles_away_from_needle() {
+  const Eigen::MatrixX3d& x = needle_.positions_mm();
+  const double margin = contact_->options().skin_mm + 2 * needle_motion_mm_ + options_.tissue_ahead_margin_mm;
+  Eigen::Vector3d lo = x.colwise().minCoeff().transpose(), hi = x.colwise().maxCoeff().transpose();
+  if (contact_->surface().half_model()) lo.z() = std::min(lo.z(), -hi.z());  // the contact also pushes with the mirror image
+  lo.array() -= margin;
+  hi.array() += margin;
+  const std::vector<Vec3d>& p = tissue_.particles().position_mm;
+  still_.resize(p.size());
+  parallel_for(static_cast<std::int64_t>(p.size()), [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t i = begin; i < end; ++i) {
+      const Vec3d& q = p[static_cast<size_t>(i)];
+      still_[static_cast<size_t>(i)] = (q.array() < lo.array()).any() || (q.array() > hi.array()).any();
+    }
+  });
 }
 
 double CoupledInsertion::plan_time_step(double end_time_ms) const {

@@ -8,7 +8,8 @@
 //   2. the tissue's first half of velocity Verlet: half kick and drift to its end positions;
 //   3. the contact begins the step: geometry from both bodies (particles at their end, needle at its start);
 //   4. the needle advances to t + dt under the contact's loads, subcycling at its own step (the contact's
-//      gap is updated from both bodies' motion at every needle step);
+//      gap is updated from both bodies' motion at every needle step); beside it, on the other threads, the
+//      particles away from the needle update their stresses (step 6's first stage, which the contact cannot change);
 //   5. the contact ends the step: its force at t + dt on the particles (penalty) or its impulses (projection);
 //   6. the tissue's second half: its forces at t + dt with the contact's, the half kick;
 //   7. each separation model separates the tissue (the needle's cut, the slit, the crack);
@@ -43,6 +44,13 @@ struct CouplingOptions {
   double max_depth_mm = 0.3;         // stop when a particle gets this deep inside the needle
   double tissue_mass_scaling_dt_ms = 0.0;  // the tissue's selective mass scaling to this step (0: none; tissue_mass_scaling.h)
   Eigen::Vector3d tissue_body_acceleration_mm_per_ms2 = Eigen::Vector3d::Zero();  // e.g. to press a block on
+  // Step 4 runs beside the stress update of the particles away from the needle (its solve is serial), which the
+  // contact cannot move: the same result, bit for bit, as one after the other (false: one after the other).
+  // Away: their whole support lies outside the needle's box at the step's start (with a half model's mirror image), widened by the contact's skin,
+  // twice the needle's largest node motion of the last step and this margin; a run in which the contact moves
+  // a particle there stops with a SolverError.
+  bool tissue_beside_needle = true;
+  double tissue_ahead_margin_mm = 0.1;
   void validate(const std::string& where = "coupling") const;
 };
 
@@ -81,6 +89,8 @@ class CoupledInsertion {
 
  private:
   double plan_time_step(double end_time_ms) const;
+  // Flags the particles away from the needle (CouplingOptions::tissue_beside_needle) into still_.
+  void mark_particles_away_from_needle();
   void check_health();  // penetration and the energy balance; SolverError beyond their limits
 
   NeedleModel& needle_;
@@ -97,6 +107,9 @@ class CoupledInsertion {
   } loads_;
   std::vector<std::unique_ptr<SeparationModel>> separations_;
   std::vector<Vec3d> contact_force_N_;  // the contact's force on each particle at the step's end
+  std::vector<std::uint8_t> still_;     // particles away from the needle this step
+  Eigen::MatrixX3d needle_x_before_;    // the needle's nodes at the last step's start
+  double needle_motion_mm_ = 0;         // the largest node motion over the last step
   InsertionEnergy energy_;
   double last_dt_ms_ = 0, max_energy_error_ = 0, max_depth_ = 0;
   int max_inside_ = 0;

@@ -13,6 +13,7 @@ namespace needle {
 namespace {
 
 constexpr double kMinJacobian = 1e-3;  // a particle compressed below 1/1000 of its volume is a blow-up
+enum : std::uint8_t { kCapped = 1, kFailed = 2, kDetached = 4 };  // a point's status after its update
 
 Vec3d gather_defect(const RkShapeFunctions& rk, std::int64_t i, const std::vector<Vec3d>& field) {
   Vec3d smoothed = Vec3d::Zero();
@@ -139,70 +140,108 @@ std::int64_t SpgTissue::valid_integration_points() const {
   return std::count(rk_.valid.begin(), rk_.valid.end(), std::uint8_t{1});
 }
 
-ForceReport SpgTissue::compute_forces(double dt_ms) {
-  ForceReport report;
-  const std::int64_t n = p_.size();
-  enum : std::uint8_t { kCapped = 1, kFailed = 2, kDetached = 4 };
+void SpgTissue::update_point(size_t s, double dt_ms) {
   std::vector<std::uint8_t>& status = point_status_;
-  std::fill(status.begin(), status.end(), std::uint8_t{0});
   const bool viscoelastic = material_.viscoelastic();
-  // 1. Deformation gradient, stress update, V P and the smoothing defect at every integration point.
+  const std::int64_t i = static_cast<std::int64_t>(s);
+  if (!rk_.valid[s]) {
+    defect_[s].setZero();
+    p_.defect_mm[s] = 0;
+    piola_volume_[s].setZero();
+    p_.stress_MPa[s].setZero();
+    reset_material_state(s);
+    p_.effective_strain[s] = p_.plastic_strain[s];
+    return;
+  }
+  Mat3d F;
+  gather_defect_and_gradient(rk_, i, p_.position_mm, defect_[s], F);
+  p_.defect_mm[s] = defect_[s].norm();
+  const double J = F.determinant();
+  const bool collapsed = !(J > kMinJacobian) || !F.allFinite();
+  if (!crack_face_support_holds(F, J)) {
+    // A particle on a crack face (some bonds cut) whose remaining support collapses stops being an
+    // integration point: it keeps its mass and moves on as a free particle. Intact material that
+    // inverts is a blow-up; intact material merely compressed that far stays.
+    bool on_crack = false;
+    for (std::int64_t e = rk_.offset[s]; e < rk_.offset[s + 1] && !on_crack; ++e) on_crack = rk_.cut[static_cast<size_t>(e)];
+    if (collapsed && !on_crack) {
+      status[s] = kFailed;
+      return;
+    }
+    if (on_crack) {
+      status[s] = kDetached;  // detach() below, serially (it counts)
+      return;
+    }
+  }
+  if (dt_ms > 0) {
+    MaterialPoint point;
+    point.elastic_left_cauchy_green = p_.elastic_left_cauchy_green[s];
+    point.plastic_strain = p_.plastic_strain[s];
+    if (viscoelastic) {
+      point.relaxed_stress_MPa = p_.relaxed_stress_MPa[s];
+      point.elastic_deviator_MPa = p_.elastic_deviator_MPa[s];
+    }
+    const StressUpdate u = update_stress(material_, point, F * p_.deformation_gradient[s].inverse(), dt_ms);
+    p_.stress_MPa[s] = u.cauchy_stress_MPa;
+    p_.elastic_left_cauchy_green[s] = u.state.elastic_left_cauchy_green;
+    p_.plastic_strain[s] = u.state.plastic_strain;
+    if (viscoelastic) {
+      p_.relaxed_stress_MPa[s] = u.state.relaxed_stress_MPa;
+      p_.elastic_deviator_MPa[s] = u.state.elastic_deviator_MPa;
+    }
+    p_.effective_strain[s] = u.effective_strain;
+    if (u.rate_factor_capped) status[s] = kCapped;
+  }
+  p_.deformation_gradient[s] = F;
+  set_stretch_bounds(s);
+  piola_volume_[s] = p_.reference_volume_mm3[s] * J * p_.stress_MPa[s] * F.inverse().transpose();
+}
+
+std::int64_t SpgTissue::update_points_ahead(double dt_ms, const std::vector<std::uint8_t>& still) {
+  const std::int64_t n = p_.size();
+  NEEDLE_REQUIRE(still.size() == static_cast<size_t>(n), "update_points_ahead: one flag per particle");
+  NEEDLE_REQUIRE(ahead_dt_ms_ < 0, "update_points_ahead: the points updated ahead were not used by compute_forces yet");
+  std::fill(point_status_.begin(), point_status_.end(), std::uint8_t{0});
+  ahead_.assign(static_cast<size_t>(n), 0);
+  still_ = still;
+  ahead_dt_ms_ = dt_ms;
   parallel_for(n, [&](std::int64_t begin, std::int64_t end) {
     for (std::int64_t i = begin; i < end; ++i) {
       const size_t s = static_cast<size_t>(i);
-      if (!rk_.valid[s]) {
-        defect_[s].setZero();
-        p_.defect_mm[s] = 0;
-        piola_volume_[s].setZero();
-        p_.stress_MPa[s].setZero();
-        reset_material_state(s);
-        p_.effective_strain[s] = p_.plastic_strain[s];
-        continue;
-      }
-      Mat3d F;
-      gather_defect_and_gradient(rk_, i, p_.position_mm, defect_[s], F);
-      p_.defect_mm[s] = defect_[s].norm();
-      const double J = F.determinant();
-      const bool collapsed = !(J > kMinJacobian) || !F.allFinite();
-      if (!crack_face_support_holds(F, J)) {
-        // A particle on a crack face (some bonds cut) whose remaining support collapses stops being an
-        // integration point: it keeps its mass and moves on as a free particle. Intact material that
-        // inverts is a blow-up; intact material merely compressed that far stays.
-        bool on_crack = false;
-        for (std::int64_t e = rk_.offset[s]; e < rk_.offset[s + 1] && !on_crack; ++e) on_crack = rk_.cut[static_cast<size_t>(e)];
-        if (collapsed && !on_crack) {
-          status[s] = kFailed;
-          continue;
-        }
-        if (on_crack) {
-          status[s] = kDetached;  // detach() below, serially (it counts)
-          continue;
-        }
-      }
-      if (dt_ms > 0) {
-        MaterialPoint point;
-        point.elastic_left_cauchy_green = p_.elastic_left_cauchy_green[s];
-        point.plastic_strain = p_.plastic_strain[s];
-        if (viscoelastic) {
-          point.relaxed_stress_MPa = p_.relaxed_stress_MPa[s];
-          point.elastic_deviator_MPa = p_.elastic_deviator_MPa[s];
-        }
-        const StressUpdate u = update_stress(material_, point, F * p_.deformation_gradient[s].inverse(), dt_ms);
-        p_.stress_MPa[s] = u.cauchy_stress_MPa;
-        p_.elastic_left_cauchy_green[s] = u.state.elastic_left_cauchy_green;
-        p_.plastic_strain[s] = u.state.plastic_strain;
-        if (viscoelastic) {
-          p_.relaxed_stress_MPa[s] = u.state.relaxed_stress_MPa;
-          p_.elastic_deviator_MPa[s] = u.state.elastic_deviator_MPa;
-        }
-        p_.effective_strain[s] = u.effective_strain;
-        if (u.rate_factor_capped) status[s] = kCapped;
-      }
-      p_.deformation_gradient[s] = F;
-      set_stretch_bounds(s);
-      piola_volume_[s] = p_.reference_volume_mm3[s] * J * p_.stress_MPa[s] * F.inverse().transpose();
+      if (!still[s]) continue;
+      bool row_still = true;
+      for (std::int64_t e = rk_.offset[s]; e < rk_.offset[s + 1] && row_still; ++e) row_still = still[static_cast<size_t>(rk_.centre[static_cast<size_t>(e)])];
+      if (!row_still) continue;
+      update_point(s, dt_ms);
+      ahead_[s] = 1;
     }
   });
+  return std::count(ahead_.begin(), ahead_.end(), std::uint8_t{1});
+}
+
+void SpgTissue::check_may_move(std::int64_t i) const {
+  if (ahead_dt_ms_ >= 0 && still_[static_cast<size_t>(i)])
+    throw SolverError(fmt::format("particle {} near x = ({:.3f}, {:.3f}, {:.3f}) mm moves within a step in which the stresses around it were "
+                                  "updated ahead, as if it stayed (the coupling's margin around the needle was too small: "
+                                  "solver.tissue_ahead_margin_mm, or solver.tissue_beside_needle false)",
+                                  i, p_.position_mm[static_cast<size_t>(i)].x(), p_.position_mm[static_cast<size_t>(i)].y(),
+                                  p_.position_mm[static_cast<size_t>(i)].z()));
+}
+
+ForceReport SpgTissue::compute_forces(double dt_ms) {
+  ForceReport report;
+  const std::int64_t n = p_.size();
+  std::vector<std::uint8_t>& status = point_status_;
+  // 1. Deformation gradient, stress update, V P and the smoothing defect at every integration point (but those
+  // update_points_ahead did).
+  const bool ahead = ahead_dt_ms_ >= 0;
+  NEEDLE_REQUIRE(!ahead || ahead_dt_ms_ == dt_ms, "compute_forces: the points updated ahead were updated for another step");
+  if (!ahead) std::fill(status.begin(), status.end(), std::uint8_t{0});
+  parallel_for(n, [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t i = begin; i < end; ++i)
+      if (!ahead || !ahead_[static_cast<size_t>(i)]) update_point(static_cast<size_t>(i), dt_ms);
+  });
+  ahead_dt_ms_ = -1;
   for (std::int64_t i = 0; i < n; ++i)
     if (status[static_cast<size_t>(i)] & kFailed)
       throw SolverError(fmt::format("particle {} inverted or blew up (det F <= {} or not finite) near x = ({:.3f}, {:.3f}, {:.3f}) mm",
@@ -310,6 +349,7 @@ std::int64_t SpgTissue::cut_bonds(const std::vector<std::int64_t>& bond_indices)
 }
 
 std::int64_t SpgTissue::separate(const std::vector<std::pair<std::int64_t, std::uint8_t>>& breaking) {
+  NEEDLE_REQUIRE(ahead_dt_ms_ < 0, "bonds break between update_points_ahead and compute_forces");
   std::vector<std::int64_t> rows;
   for (const auto& [b, kind] : breaking) {
     bonds_.mark_broken(b);

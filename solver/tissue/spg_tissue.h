@@ -62,6 +62,13 @@ class SpgTissue {
   // stress update). Then breaks the bonds that reached the failure criterion and rebuilds their rows.
   // SolverError on an inverted or non-finite particle.
   ForceReport compute_forces(double dt_ms);
+  // compute_forces(dt_ms)'s first stage (deformation gradient, stress update, V P) done ahead, e.g. beside the
+  // needle's solve, for the particles whose row's centres all stay where they are until compute_forces: those
+  // `still` flags (one per particle) name. compute_forces(dt_ms) then does the others and the rest; the result
+  // is the one of a single call, bit for bit. Returns how many points it updated. Until compute_forces, a still
+  // particle must not move: check_may_move throws a SolverError for one that is about to.
+  std::int64_t update_points_ahead(double dt_ms, const std::vector<std::uint8_t>& still);
+  void check_may_move(std::int64_t i) const;
 
   // Breaks the given bonds (indices into bonds(); already broken ones are skipped) whatever the strains
   // say, e.g. where the needle's body separates their particles (needle_bond_cut.h), and rebuilds their
@@ -100,6 +107,8 @@ class SpgTissue {
   // Marks the bonds listed in breaking, in increasing order with their kind (1: cut, 2: dead, no live row
   // changes), broken and rebuilds the rows of their particles; the count of those newly broken.
   std::int64_t separate(const std::vector<std::pair<std::int64_t, std::uint8_t>>& breaking);
+  // Point s's deformation gradient, stress update, V P and smoothing defect; its status flags.
+  void update_point(size_t s, double dt_ms);
   // Whether a crack-face particle's support still measures a volume (SpgOptions::crack_face_min_volume_ratio).
   bool crack_face_support_holds(const Mat3d& F, double J) const;
   // Particle s stops being an integration point: its row, smoothing defect and stress are cleared; it
@@ -124,6 +133,8 @@ class SpgTissue {
   mutable std::vector<double> min_stretch_;
   std::vector<double> stretch_lower_, stretch_upper_;
   std::vector<std::uint8_t> point_status_;  // scratch flags of compute_forces
+  double ahead_dt_ms_ = -1;                  // the step update_points_ahead updated points for (-1: none pending)
+  std::vector<std::uint8_t> ahead_, still_;  // the points it updated; the particles it was told stay
   Eigen::MatrixX3d reference_;            // #P by 3 copy of reference_mm for the shape-function builders
   std::vector<Vec3d> defect_;      // g_i
   std::vector<Mat3d> piola_volume_;  // V_i P_i

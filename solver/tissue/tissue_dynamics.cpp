@@ -251,6 +251,7 @@ double TissueDynamics::apply_impulses(std::vector<std::pair<std::int32_t, Vec3d>
     const size_t s = static_cast<size_t>(particle);
     for (int axis = 0; axis < 3; ++axis)
       if (constrained_mask_[s] & (1 << axis)) J[axis] = 0;
+    if (!J.isZero(0.0)) tissue_.check_may_move(particle);
     const Vec3d dv = J / p.mass_g[s];
     Vec3d& v = p.velocity_mm_per_ms[s];
     work += J.dot(v + 0.5 * dv);
