@@ -127,6 +127,13 @@ void NeedleTissueContact::probe(const std::vector<Vec3d>& x, const Eigen::Matrix
   const Eigen::MatrixX3i& tri = surface_.triangles();
   const Eigen::MatrixX3d& X0 = surface_.reference_positions();
   const double skin = options_.skin_mm;
+  // The needle's own box (with a half model's mirror image, which the level set closes the surface with). A
+  // particle farther outside it than the skin, its reach and a slack is outside the needle and beyond contact:
+  // the search below would find it so, as the slack (5 voxels and 0.1 mm) is far above the errors of the
+  // pull-back and of the level set's interpolation. Most of the particles around the needle are that far.
+  Eigen::Vector3d needle_lo = box_lo_;
+  if (surface_.half_model()) needle_lo.z() = std::min(needle_lo.z(), -box_hi_.z());
+  const double slack = 0.1 + 5 * options_.voxel_mm;
   probes.resize(x.size());
   parallel_for(static_cast<std::int64_t>(x.size()), [&](std::int64_t begin, std::int64_t end) {
     for (std::int64_t i = begin; i < end; ++i) {
@@ -135,6 +142,8 @@ void NeedleTissueContact::probe(const std::vector<Vec3d>& x, const Eigen::Matrix
       probe = Probe{};
       const Eigen::Vector3d p = x[s];
       if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) continue;
+      const double beyond = skin + reach[s] + slack;
+      if ((needle_lo - p).cwiseMax(p - box_hi_).cwiseMax(0.0).squaredNorm() > beyond * beyond) continue;
       const int node = nearest_surface_node(p);
       if (node < 0) continue;
       const Eigen::Vector3d X = surface_.pull_back(p, node, needle_x);
