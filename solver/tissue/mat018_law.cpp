@@ -14,10 +14,29 @@ struct RateLogs {
   double log_term, log_cap;
 };
 
+// What the law computes from the card alone, once per card and thread instead of at every point: the yield
+// stress at no plastic strain and factor 1 (less 1e-9 of it), and log_cap. The same values as computed at each
+// call, so the same results to the last bit.
+struct CardConstants {
+  double E = 0, k = 0, n = 0, max_rate_factor = 0;
+  double initial_yield_floor_MPa = 0, log_cap = 0;
+};
+
+const CardConstants& card_constants(const TissueMaterial& m) {
+  thread_local CardConstants c;
+  if (c.E != m.E_MPa || c.k != m.k_MPa || c.n != m.n || c.max_rate_factor != m.max_rate_factor || c.k == 0) {
+    c.E = m.E_MPa, c.k = m.k_MPa, c.n = m.n, c.max_rate_factor = m.max_rate_factor;
+    // yield_stress_MPa(eps_p, 1) = k (eps_yp + eps_p)^n is at least k eps_yp^n: pow rises with its base and is
+    // accurate to an ulp, far inside the 1e-9 kept in hand.
+    c.initial_yield_floor_MPa = m.yield_stress_MPa(0.0, 1.0) * (1 - 1e-9);
+    c.log_cap = std::log(m.max_rate_factor - 1.0 > 0 ? m.max_rate_factor - 1.0 : 1e-300);
+  }
+  return c;
+}
+
 RateLogs rate_logs(const TissueMaterial& m, double strain_rate_per_ms) {
   const double exponent = m.rate_law == RateLaw::printed ? 1.0 / m.rate_p : m.rate_p;
-  return {exponent * std::log(strain_rate_per_ms / m.rate_C_per_ms),
-          std::log(m.max_rate_factor - 1.0 > 0 ? m.max_rate_factor - 1.0 : 1e-300)};
+  return {exponent * std::log(strain_rate_per_ms / m.rate_C_per_ms), card_constants(m).log_cap};
 }
 
 }  // namespace
@@ -56,7 +75,8 @@ Eigen::Vector3d mat018_deviatoric_stress(const TissueMaterial& m, const Incremen
   // The rate factor is at least 1 and only raises the yield stress: a trial within the yield stress at factor 1 is
   // elastic at any rate, and where the rate cannot reach the factor's cap either, the rate is not needed (most
   // particles, most steps: it is an eigenvalue problem).
-  if (q_trial <= m.yield_stress_MPa(eps_p, 1.0) && m.rate_factor_uncapped_up_to(rate.upper_bound())) {
+  if ((q_trial <= card_constants(m).initial_yield_floor_MPa || q_trial <= m.yield_stress_MPa(eps_p, 1.0)) &&
+      m.rate_factor_uncapped_up_to(rate.upper_bound())) {
     capped = false;
     return s;
   }
