@@ -1,6 +1,8 @@
 #include "solver/tissue/tissue_dynamics.h"
 
 #include <algorithm>
+#include <array>
+#include <atomic>
 #include <cmath>
 #include <fmt/format.h>
 
@@ -193,17 +195,31 @@ StepReport TissueDynamics::finish_step(const std::vector<Vec3d>* external_force_
   } else {
     old_external_force_ = external_force_;
   }
-  // old_force holds internal + external at the step's start; split the trapezoid sums accordingly.
+  // old_force holds internal + external at the step's start; split the trapezoid sums accordingly. Each particle's
+  // terms in parallel, their sums in particle order (the same bits for any thread count).
+  work_terms_.resize(static_cast<size_t>(n));
+  std::atomic<std::int64_t> non_finite{n};
+  parallel_for(n, [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t i = begin; i < end; ++i) {
+      const size_t s = static_cast<size_t>(i);
+      if (!p.force_N[s].allFinite() || !external_force_[s].allFinite()) {
+        std::int64_t first = non_finite.load();
+        while (i < first && !non_finite.compare_exchange_weak(first, i)) {
+        }
+      }
+      const Vec3d old_internal = old_force[s] - old_external_force_[s];
+      work_terms_[s] = {0.5 * (old_internal + p.force_N[s]).dot(displacement[s]),
+                        0.5 * (old_external_force_[s] + external_force_[s]).dot(displacement[s]),
+                        p.mass_g[s] * body_acceleration_.dot(displacement[s])};
+      acceleration_[s] = (p.force_N[s] + external_force_[s]) / p.mass_g[s] + body_acceleration_;
+    }
+  });
+  if (non_finite.load() < n) throw SolverError(fmt::format("non-finite force on particle {} at t = {:.6g} ms", non_finite.load(), time_ms_));
   double model_work = 0, body_work = 0, external_work = 0;
-  for (std::int64_t i = 0; i < n; ++i) {
-    const size_t s = static_cast<size_t>(i);
-    if (!p.force_N[s].allFinite() || !external_force_[s].allFinite())
-      throw SolverError(fmt::format("non-finite force on particle {} at t = {:.6g} ms", i, time_ms_));
-    const Vec3d old_internal = old_force[s] - old_external_force_[s];
-    model_work += 0.5 * (old_internal + p.force_N[s]).dot(displacement[s]);
-    external_work += 0.5 * (old_external_force_[s] + external_force_[s]).dot(displacement[s]);
-    body_work += p.mass_g[s] * body_acceleration_.dot(displacement[s]);
-    acceleration_[s] = (p.force_N[s] + external_force_[s]) / p.mass_g[s] + body_acceleration_;
+  for (const std::array<double, 3>& terms : work_terms_) {
+    model_work += terms[0];
+    external_work += terms[1];
+    body_work += terms[2];
   }
   // A particle an impulse moved between the halves: the first half's forces worked through the drift it
   // had before (velocity Verlet's own account of its kinetic energy), the second half's through the whole.

@@ -14,6 +14,7 @@
 #include <limits>
 #include <memory>
 #include <utility>
+#include <array>
 #include <vector>
 
 #include "solver/tissue/spg_tissue.h"
@@ -113,6 +114,7 @@ class TissueDynamics {
     double v_half_z;
   };
   std::vector<Landing> landed_;                 // this step's impacts on the plane
+  std::vector<std::array<double, 3>> work_terms_;  // finish_step's scratch: each particle's model, external and body work
   std::vector<std::pair<std::int32_t, Vec3d>> impulse_shifts_;  // this step's: particles moved by impulses, and by how much
   std::vector<std::int32_t> constrained_;      // particles with a constrained component
   std::vector<std::uint8_t> constrained_mask_;  // per particle: bit k = component k constrained
