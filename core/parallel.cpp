@@ -24,7 +24,12 @@ void parallel_for(std::int64_t n, const std::function<void(std::int64_t, std::in
 void run_beside(const std::function<void()>& serial, const std::function<void()>& beside) {
   tbb::task_group group;
   group.run([&beside] { beside(); });
-  tbb::this_task_arena::isolate([&serial] { serial(); });
+  try {
+    tbb::this_task_arena::isolate([&serial] { serial(); });
+  } catch (...) {
+    group.wait();  // beside() works on what the caller owns: it finishes before the caller unwinds
+    throw;
+  }
   group.wait();
 }
 
