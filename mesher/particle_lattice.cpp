@@ -49,9 +49,6 @@ std::vector<double> local_spacing(const std::vector<double>& nodes) {
   return spacing;
 }
 
-// The flags of a particle at x from the box faces it lies on.
-std::uint8_t face_flags(const TissueBox& box, const Eigen::Vector3d& x, double tolerance);
-
 std::uint8_t flag_of(FaceCondition c) {
   switch (c) {
     case FaceCondition::fixed: return kParticleFixed;
@@ -61,6 +58,7 @@ std::uint8_t flag_of(FaceCondition c) {
   return 0;
 }
 
+// The flags of a particle at x from the box faces it lies on (within tolerance).
 std::uint8_t face_flags(const TissueBox& box, const Eigen::Vector3d& x, double tolerance) {
   std::uint8_t flags = 0;
   for (int k = 0; k < 3; ++k) {
@@ -94,14 +92,13 @@ ParticleSet nested_lattice(const TissueBox& box, double h, const RegionOfInteres
     fine_spacing[k] = local_spacing(fine[k]);
     // A face of the region inside the box: its fine nodes' cells reach half a coarse interval out (the coarse
     // cells there are gone with the coarse nodes on the face), and their nearest neighbour out is a coarse node.
-    const double coarse_step = step;
     if (lo[k] > box.min_mm[k] + tolerance) {
-      fine_dual[k].front() += 0.5 * coarse_step;
-      fine_spacing[k].front() = std::max(fine_spacing[k].front(), coarse_step);
+      fine_dual[k].front() += 0.5 * step;
+      fine_spacing[k].front() = std::max(fine_spacing[k].front(), step);
     }
     if (hi[k] < box.max_mm[k] - tolerance) {
-      fine_dual[k].back() += 0.5 * coarse_step;
-      fine_spacing[k].back() = std::max(fine_spacing[k].back(), coarse_step);
+      fine_dual[k].back() += 0.5 * step;
+      fine_spacing[k].back() = std::max(fine_spacing[k].back(), step);
     }
   }
   const auto inside_region = [&](const Eigen::Vector3d& x) {

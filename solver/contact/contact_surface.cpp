@@ -157,6 +157,15 @@ ContactSurface::ContactSurface(const TetMesh& mesh, const ContactSurfaceOptions&
   for (const auto& e : entries) cell_triangles_.push_back(e.second);
 }
 
+void ContactSurface::closed_bounds(const Eigen::MatrixX3d& x, Eigen::Vector3d& lo, Eigen::Vector3d& hi) const {
+  lo = hi = x.row(nodes_.front()).transpose();
+  for (int n : nodes_) {
+    lo = lo.cwiseMin(x.row(n).transpose());
+    hi = hi.cwiseMax(x.row(n).transpose());
+  }
+  if (half_model_) lo.z() = std::min(lo.z(), -hi.z());
+}
+
 SurfacePoint ContactSurface::locate(const Eigen::Vector3d& p) const {
   SurfacePoint best;
   const Eigen::Vector3i c = ((p - grid_origin_) / grid_cell_mm_).array().floor().cast<int>();

@@ -45,6 +45,9 @@ class ContactSurface {
   const std::vector<int>& nodes() const { return nodes_; }  // FE nodes on the contact surface
   const Eigen::MatrixX3d& reference_positions() const { return reference_; }  // all FE nodes, mm
   bool half_model() const { return half_model_; }
+  // The box of the surface nodes at x (rows: all FE nodes), widened to the mirror image a half model's surface is
+  // closed with (z from -max z): where the contact can push a particle from.
+  void closed_bounds(const Eigen::MatrixX3d& x, Eigen::Vector3d& lo, Eigen::Vector3d& hi) const;
   const NeedleLevelSet& level_set() const { return *level_set_; }
   // Radius of the largest ball around any interior point free of surface nodes: the search radius
   // for the pull-back node.

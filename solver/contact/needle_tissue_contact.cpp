@@ -131,8 +131,8 @@ void NeedleTissueContact::probe(const std::vector<Vec3d>& x, const Eigen::Matrix
   // particle farther outside it than the skin, its reach and a slack is outside the needle and beyond contact:
   // the search below would find it so, as the slack (5 voxels and 0.1 mm) is far above the errors of the
   // pull-back and of the level set's interpolation. Most of the particles around the needle are that far.
-  Eigen::Vector3d needle_lo = box_lo_;
-  if (surface_.half_model()) needle_lo.z() = std::min(needle_lo.z(), -box_hi_.z());
+  Eigen::Vector3d needle_lo, needle_hi;
+  surface_.closed_bounds(needle_x, needle_lo, needle_hi);
   const double slack = 0.1 + 5 * options_.voxel_mm;
   probes.resize(x.size());
   parallel_for(static_cast<std::int64_t>(x.size()), [&](std::int64_t begin, std::int64_t end) {
@@ -143,7 +143,7 @@ void NeedleTissueContact::probe(const std::vector<Vec3d>& x, const Eigen::Matrix
       const Eigen::Vector3d p = x[s];
       if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) continue;
       const double beyond = skin + reach[s] + slack;
-      if ((needle_lo - p).cwiseMax(p - box_hi_).cwiseMax(0.0).squaredNorm() > beyond * beyond) continue;
+      if ((needle_lo - p).cwiseMax(p - needle_hi).cwiseMax(0.0).squaredNorm() > beyond * beyond) continue;
       const int node = nearest_surface_node(p);
       if (node < 0) continue;
       const Eigen::Vector3d X = surface_.pull_back(p, node, needle_x);

@@ -82,10 +82,9 @@ ContactReport CoupledInsertion::contact() const {
 }
 
 void CoupledInsertion::mark_particles_away_from_needle() {
-  const Eigen::MatrixX3d& x = needle_.positions_mm();
   const double margin = contact_->options().skin_mm + 2 * needle_motion_mm_ + options_.tissue_ahead_margin_mm;
-  Eigen::Vector3d lo = x.colwise().minCoeff().transpose(), hi = x.colwise().maxCoeff().transpose();
-  if (contact_->surface().half_model()) lo.z() = std::min(lo.z(), -hi.z());  // the contact also pushes with the mirror image
+  Eigen::Vector3d lo, hi;
+  contact_->surface().closed_bounds(needle_.positions_mm(), lo, hi);
   lo.array() -= margin;
   hi.array() += margin;
   const std::vector<Vec3d>& p = tissue_.particles().position_mm;
