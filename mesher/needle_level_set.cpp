@@ -17,11 +17,22 @@ struct NeedleLevelSet::Impl {
   openvdb::FloatGrid::Ptr grid;
   double voxel = 0, band = 0, interior_band = 0, seconds = 0;
 
-  double sample(const Eigen::Vector3d& p) const {
-    openvdb::FloatGrid::ConstAccessor accessor = grid->getConstAccessor();
-    openvdb::tools::GridSampler<openvdb::FloatGrid::ConstAccessor, openvdb::tools::BoxSampler> sampler(accessor, grid->transform());
-    return sampler.wsSample(openvdb::Vec3d(p.x(), p.y(), p.z()));
-  }
+  // Trilinear samples through one accessor. An unregistered ("unsafe") one: the grid does not change after it is
+  // built, and a registered accessor costs a lock on the tree's registry to make and to drop, per query.
+  class Sampler {
+   public:
+    explicit Sampler(const openvdb::FloatGrid& grid) : accessor_(grid.getConstUnsafeAccessor()), transform_(grid.transform()) {}
+    // What GridSampler<accessor, BoxSampler>::wsSample computes (it takes registered accessors only).
+    double operator()(const Eigen::Vector3d& p) const {
+      float value = 0;
+      openvdb::tools::BoxSampler::sample(accessor_, transform_.worldToIndex(openvdb::Vec3d(p.x(), p.y(), p.z())), value);
+      return value;
+    }
+
+   private:
+    openvdb::FloatGrid::ConstUnsafeAccessor accessor_;
+    const openvdb::math::Transform& transform_;
+  };
 };
 
 NeedleLevelSet::NeedleLevelSet(const TriSurface& surface, const LevelSetOptions& options) : impl_(std::make_unique<Impl>()) {
@@ -63,14 +74,15 @@ NeedleLevelSet::~NeedleLevelSet() = default;
 NeedleLevelSet::NeedleLevelSet(NeedleLevelSet&&) noexcept = default;
 NeedleLevelSet& NeedleLevelSet::operator=(NeedleLevelSet&&) noexcept = default;
 
-double NeedleLevelSet::signed_distance_mm(const Eigen::Vector3d& p) const { return impl_->sample(p); }
+double NeedleLevelSet::signed_distance_mm(const Eigen::Vector3d& p) const { return Impl::Sampler(*impl_->grid)(p); }
 
 Eigen::Vector3d NeedleLevelSet::gradient(const Eigen::Vector3d& p) const {
+  const Impl::Sampler sample(*impl_->grid);
   Eigen::Vector3d g;
   const double h = impl_->voxel;
   for (int k = 0; k < 3; ++k) {
     const Eigen::Vector3d e = Eigen::Vector3d::Unit(k) * h;
-    g[k] = (impl_->sample(p + e) - impl_->sample(p - e)) / (2 * h);
+    g[k] = (sample(p + e) - sample(p - e)) / (2 * h);
   }
   return g;
 }

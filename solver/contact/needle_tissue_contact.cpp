@@ -134,47 +134,44 @@ void NeedleTissueContact::probe(const std::vector<Vec3d>& x, const Eigen::Matrix
   Eigen::Vector3d needle_lo, needle_hi;
   surface_.closed_bounds(needle_x, needle_lo, needle_hi);
   const double slack = 0.1 + 5 * options_.voxel_mm;
-  probes.resize(x.size());
-  parallel_for(static_cast<std::int64_t>(x.size()), [&](std::int64_t begin, std::int64_t end) {
-    for (std::int64_t i = begin; i < end; ++i) {
-      const size_t s = static_cast<size_t>(i);
-      Probe& probe = probes[s];
-      probe = Probe{};
-      const Eigen::Vector3d p = x[s];
-      if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) continue;
-      const double beyond = skin + reach[s] + slack;
-      if ((needle_lo - p).cwiseMax(p - needle_hi).cwiseMax(0.0).squaredNorm() > beyond * beyond) continue;
-      const int node = nearest_surface_node(p);
-      if (node < 0) continue;
-      const Eigen::Vector3d X = surface_.pull_back(p, node, needle_x);
-      const double phi = level_set.signed_distance_mm(X);
-      probe.phi = phi;
-      probe.inside = phi < 0;
-      if (phi >= skin + reach[s]) continue;
-      Eigen::Vector3d normal = level_set.gradient(X);
-      if (!(normal.norm() > 1e-6)) continue;  // outside the band: farther than any reach
-      normal.normalize();
-      Pair& pair = probe.pair;
-      pair.particle = static_cast<int>(i);
-      const SurfacePoint at = surface_.locate(X - phi * normal);
-      if (at.triangle >= 0) {
-        pair.triangle = at.triangle;
-        pair.weights = at.weights;
-        // Turn the reference normal with the triangle under the point.
-        const auto corner = [&](const Eigen::MatrixX3d& m, int k) { return m.row(tri(at.triangle, k)).transpose().eval(); };
-        const Eigen::Vector3d n_ref = (corner(X0, 1) - corner(X0, 0)).cross(corner(X0, 2) - corner(X0, 0)).normalized();
-        const Eigen::Vector3d n_cur =
-            (corner(needle_x, 1) - corner(needle_x, 0)).cross(corner(needle_x, 2) - corner(needle_x, 0)).normalized();
-        if (n_ref.allFinite() && n_cur.allFinite()) normal = (normal + n_cur - n_ref).normalized();
-      } else {
-        pair.node = node;
-      }
-      pair.normal = normal;
-      pair.particle_start = p;
-      pair.surface_start = surface_point(pair, needle_x);
-      pair.gap_start = skin - phi;
-      probe.near = true;
+  probes = parallel_collect<Probe>(static_cast<std::int64_t>(x.size()), [&](std::int64_t i, std::vector<Probe>& found) {
+    const size_t s = static_cast<size_t>(i);
+    const Eigen::Vector3d p = x[s];
+    if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) return;
+    const double beyond = skin + reach[s] + slack;
+    if ((needle_lo - p).cwiseMax(p - needle_hi).cwiseMax(0.0).squaredNorm() > beyond * beyond) return;
+    const int node = nearest_surface_node(p);
+    if (node < 0) return;
+    const Eigen::Vector3d X = surface_.pull_back(p, node, needle_x);
+    Probe& probe = found.emplace_back();
+    probe.index = static_cast<int>(i);
+    const double phi = level_set.signed_distance_mm(X);
+    probe.phi = phi;
+    probe.inside = phi < 0;
+    if (phi >= skin + reach[s]) return;
+    Eigen::Vector3d normal = level_set.gradient(X);
+    if (!(normal.norm() > 1e-6)) return;  // outside the band: farther than any reach
+    normal.normalize();
+    Pair& pair = probe.pair;
+    pair.particle = static_cast<int>(i);
+    const SurfacePoint at = surface_.locate(X - phi * normal);
+    if (at.triangle >= 0) {
+      pair.triangle = at.triangle;
+      pair.weights = at.weights;
+      // Turn the reference normal with the triangle under the point.
+      const auto corner = [&](const Eigen::MatrixX3d& m, int k) { return m.row(tri(at.triangle, k)).transpose().eval(); };
+      const Eigen::Vector3d n_ref = (corner(X0, 1) - corner(X0, 0)).cross(corner(X0, 2) - corner(X0, 0)).normalized();
+      const Eigen::Vector3d n_cur =
+          (corner(needle_x, 1) - corner(needle_x, 0)).cross(corner(needle_x, 2) - corner(needle_x, 0)).normalized();
+      if (n_ref.allFinite() && n_cur.allFinite()) normal = (normal + n_cur - n_ref).normalized();
+    } else {
+      pair.node = node;
     }
+    pair.normal = normal;
+    pair.particle_start = p;
+    pair.surface_start = surface_point(pair, needle_x);
+    pair.gap_start = skin - phi;
+    probe.near = true;
   });
 }
 

@@ -119,13 +119,16 @@ class NeedleTissueContact : public NeedleLoads {
     double stiffness = 0, damping = 0, friction_cap = 0;       // the penalty law's constants over the step
   };
   struct Probe {  // one particle's geometric query
+    int index = -1;  // the position's index in the probed list
     bool near = false, inside = false;
     double phi = 0;
     Pair pair;
   };
   // Level-set query of every particle at positions x (reach: how far outside the skin still counts as near).
   // same_needle: the needle has not moved since the last probe, whose grid of surface nodes serves again.
-  // The probes go to `out` (default: probes_), one per position.
+  // The probes go to `out` (default: probes_), in increasing index, one for each position whose signed distance
+  // was looked up: the others (far outside the needle's box, or with no surface node near) are neither near
+  // nor inside, and have no probe.
   void probe(const std::vector<Vec3d>& x, const Eigen::MatrixX3d& needle_x, const std::vector<double>& reach, bool same_needle = false,
              std::vector<Probe>* out = nullptr);
   Eigen::Vector3d surface_point(const Pair& pair, const Eigen::MatrixX3d& needle) const;

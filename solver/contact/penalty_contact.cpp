@@ -45,8 +45,8 @@ void PenaltyContact::begin_step(const TissueParticles& particles, const Eigen::M
   pairs_.clear();
   report_.particles_inside = 0;
   report_.max_depth_mm = 0;
-  for (size_t i = 0; i < n; ++i) {
-    const Probe& p = probes_[i];
+  for (const Probe& p : probes_) {
+    const size_t i = static_cast<size_t>(p.index);
     if (p.inside) {
       ++report_.particles_inside;
       report_.max_depth_mm = std::max(report_.max_depth_mm, -p.phi);

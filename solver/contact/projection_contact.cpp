@@ -53,8 +53,9 @@ void ProjectionContact::end_step(TissueDynamics& tissue, const Eigen::MatrixX3d&
   const double mu = options_.friction;
   std::vector<std::pair<std::int32_t, Vec3d>> impulses;
   std::vector<size_t> probe_of;  // the probe of each impulse
-  for (size_t i = 0; i < n; ++i) {
-    const Probe& p = probes_[i];
+  for (size_t k = 0; k < probes_.size(); ++k) {
+    const Probe& p = probes_[k];
+    const size_t i = static_cast<size_t>(p.index);
     if (!p.near || !(p.pair.gap_start > 0) || (particles.flags[i] & kParticleFixed)) continue;
     const Pair& pair = p.pair;
     const double m = particles.mass_g[i];  // with the tissue's mass scaling, the scaled mass
@@ -65,7 +66,7 @@ void ProjectionContact::end_step(TissueDynamics& tissue, const Eigen::MatrixX3d&
     Eigen::Vector3d j = jn;
     if (speed > 0 && mu > 0) j -= std::min(mu * jn.norm(), m * speed) / speed * v_t;
     impulses.emplace_back(static_cast<std::int32_t>(i), j);
-    probe_of.push_back(i);
+    probe_of.push_back(k);
   }
   const double particle_work = tissue.apply_impulses(impulses);  // constrained components dropped from J
   particle_work_mJ_ += particle_work;
