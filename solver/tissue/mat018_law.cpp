@@ -1,6 +1,7 @@
 #include "solver/tissue/mat018_law.h"
 
 #include <cmath>
+#include <limits>
 
 namespace needle {
 
@@ -67,6 +68,31 @@ bool TissueMaterial::rate_factor_uncapped_up_to(double strain_rate_per_ms) const
   return logs.log_term < logs.log_cap - 1e-9 * (1 + std::abs(logs.log_cap));
 }
 
+double uncapped_rate_limit_per_ms(const TissueMaterial& m) {
+  if (m.rate_law == RateLaw::off) return std::numeric_limits<double>::infinity();
+  // rate_factor_uncapped_up_to holds while exponent ln(rate / C) < log_cap - 1e-9 (1 + |log_cap|); 1e-6 of the
+  // rate below that limit is far beyond the rounding of the logarithm it compares.
+  const double exponent = m.rate_law == RateLaw::printed ? 1.0 / m.rate_p : m.rate_p;
+  const double log_cap = card_constants(m).log_cap;
+  const double log_rate = std::log(m.rate_C_per_ms) + (log_cap - 1e-9 * (1 + std::abs(log_cap))) / exponent;
+  return log_rate > 700 ? std::numeric_limits<double>::infinity() : std::exp(log_rate) * (1 - 1e-6);
+}
+
+bool rate_stays_uncapped(const TissueMaterial& m, const IncrementStrainRate& rate) {
+  // The norm below which the answer is yes, per rate law, cap and step (once per thread while they stay).
+  thread_local struct {
+    RateLaw law = RateLaw::off;
+    double C = -1, p = -1, max_factor = -1, dt = -1, norm = 0;
+  } safe;
+  if (safe.law != m.rate_law || safe.C != m.rate_C_per_ms || safe.p != m.rate_p || safe.max_factor != m.max_rate_factor ||
+      safe.dt != rate.dt_ms()) {
+    safe.law = m.rate_law, safe.C = m.rate_C_per_ms, safe.p = m.rate_p, safe.max_factor = m.max_rate_factor, safe.dt = rate.dt_ms();
+    safe.norm = IncrementStrainRate::increment_norm_bounded_below(uncapped_rate_limit_per_ms(m), rate.dt_ms());
+  }
+  if (rate.increment_norm() < safe.norm) return true;
+  return m.rate_factor_uncapped_up_to(rate.upper_bound());
+}
+
 Eigen::Vector3d mat018_deviatoric_stress(const TissueMaterial& m, const IncrementStrainRate& rate, const Eigen::Vector3d& h_dev,
                                          Eigen::Vector3d& h, double& eps_p, bool& capped) {
   const double mu = m.shear_modulus_MPa();
@@ -76,7 +102,7 @@ Eigen::Vector3d mat018_deviatoric_stress(const TissueMaterial& m, const Incremen
   // elastic at any rate, and where the rate cannot reach the factor's cap either, the rate is not needed (most
   // particles, most steps: it is an eigenvalue problem).
   if ((q_trial <= card_constants(m).initial_yield_floor_MPa || q_trial <= m.yield_stress_MPa(eps_p, 1.0)) &&
-      m.rate_factor_uncapped_up_to(rate.upper_bound())) {
+      rate_stays_uncapped(m, rate)) {
     capped = false;
     return s;
   }

@@ -15,6 +15,13 @@ namespace needle {
 Eigen::Vector3d mat018_deviatoric_stress(const TissueMaterial& m, const IncrementStrainRate& rate, const Eigen::Vector3d& h_dev,
                                          Eigen::Vector3d& h, double& eps_p, bool& capped);
 
+// Whether the rate factor stays below its cap over the increment, as m.rate_factor_uncapped_up_to(rate.upper_bound())
+// says: without its two logarithms where |f f^T - I| lies below the norm at which the bound could reach the cap
+// (both rise with the norm; the same answer, for the same results to the last bit).
+bool rate_stays_uncapped(const TissueMaterial& m, const IncrementStrainRate& rate);
+// The strain rate (1/ms) below which m.rate_factor_uncapped_up_to holds, less 1e-6 of it (infinite with no rate law).
+double uncapped_rate_limit_per_ms(const TissueMaterial& m);
+
 // The closed-form uniaxial curve (tissue_material.h: uniaxial_true_stress_MPa) of the card.
 double mat018_uniaxial_true_stress_MPa(const TissueMaterial& m, double true_strain, double strain_rate_per_ms);
 

@@ -82,13 +82,27 @@ double IncrementStrainRate::value() const {
   return value_;
 }
 
+namespace {
+constexpr double kBoundSlack = 1e-6, kBoundFloor = 1e-12;  // upper_bound's margins over value()'s rounding
+}
+
 double IncrementStrainRate::upper_bound() const {
   if (!(dt_ms_ > 0)) return 0.0;
-  const double r = (f_ * f_.transpose() - Eigen::Matrix3d::Identity()).norm();  // bounds |eig(f f^T) - 1|
+  const double r = increment_norm();  // bounds |eig(f f^T) - 1|
   if (!(r < 0.5)) return std::numeric_limits<double>::infinity();
   // |dev d| <= |d| <= sqrt(3) max |d_i|, so the rate <= sqrt(2/3) sqrt(3) (-1/2 ln(1 - r)) / dt; the margins cover the
   // rounding of the eigenvalues and logarithms value() computes (about 1e-16 each).
-  return (std::sqrt(0.5) * -std::log1p(-r) * (1 + 1e-6) + 1e-12) / dt_ms_;
+  return (std::sqrt(0.5) * -std::log1p(-r) * (1 + kBoundSlack) + kBoundFloor) / dt_ms_;
+}
+
+double IncrementStrainRate::increment_norm_bounded_below(double rate_per_ms, double dt_ms) {
+  if (!(dt_ms > 0)) return std::numeric_limits<double>::infinity();  // upper_bound() is 0
+  if (!(rate_per_ms > 0)) return 0.0;
+  // upper_bound() solved for r: -ln(1 - r) = (rate dt - floor) / (sqrt(1/2) (1 + slack)).
+  const double y = (rate_per_ms * dt_ms - kBoundFloor) / (std::sqrt(0.5) * (1 + kBoundSlack));
+  if (!(y > 0)) return 0.0;
+  const double r = std::isfinite(y) ? -std::expm1(-y) : 1.0;
+  return std::min(r, 0.5) * (1 - 1e-6);
 }
 
 StressUpdate update_stress(const TissueMaterial& m, const MaterialPoint& state, const Eigen::Matrix3d& f, double dt_ms) {

@@ -87,7 +87,12 @@ class IncrementStrainRate {
  public:
   IncrementStrainRate(const Eigen::Matrix3d& f, double dt_ms) : f_(f), dt_ms_(dt_ms) {}
   double value() const;
-  double upper_bound() const;  // >= value(), rounding included; infinite for increments beyond |f f^T - I| = 1
+  double upper_bound() const;  // >= value(), rounding included; infinite for increments beyond |f f^T - I| = 1/2
+  double increment_norm() const { return (f_ * f_.transpose() - Eigen::Matrix3d::Identity()).norm(); }  // |f f^T - I|
+  double dt_ms() const { return dt_ms_; }
+  // The largest |f f^T - I| whose upper_bound() stays below rate_per_ms, less 1e-6 of it (far beyond the
+  // rounding of upper_bound, which rises with the norm): 0 where none does.
+  static double increment_norm_bounded_below(double rate_per_ms, double dt_ms);
 
  private:
   Eigen::Matrix3d f_;

@@ -6,6 +6,7 @@
 #include <random>
 
 #include "core/input_error.h"
+#include "solver/tissue/mat018_law.h"
 #include "solver/tissue/spg_tissue.h"
 #include "solver/tissue/uniaxial_test.h"
 #include "tests/solver/solver_fixtures.h"
@@ -101,6 +102,50 @@ TEST_CASE("The increment's strain rate: its cheap bound lies above the eigenvalu
     m.rate_factor(r, &c);
     if (m.rate_factor_uncapped_up_to(r)) CHECK_FALSE(c);
   }
+}
+
+TEST_CASE("The rate check's shortcut below the cap's norm gives the exact check's answer", "[solver][material]") {
+  // An increment with f f^T = I + r N (N symmetric, |N| = 1), so |f f^T - I| = r to rounding.
+  std::mt19937 rng(5);
+  std::normal_distribution<double> g(0.0, 1.0);
+  const auto increment = [&](double r) {
+    Eigen::Matrix3d a;
+    for (int i = 0; i < 9; ++i) a(i / 3, i % 3) = g(rng);
+    const Eigen::Matrix3d n = (a + a.transpose()).normalized();
+    return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(Eigen::Matrix3d::Identity() + r * n).operatorSqrt().eval();
+  };
+  // The norm's inverse is tight: upper_bound() at it stays below the rate, a few millionths above it does not.
+  for (const auto& [rate, dt] : {std::pair{0.2, 0.002}, std::pair{50.0, 0.002}, std::pair{0.2, 1.0}, std::pair{3.0, 0.05}}) {
+    const double r = IncrementStrainRate::increment_norm_bounded_below(rate, dt);
+    INFO("rate " << rate << " dt " << dt << " norm " << r);
+    REQUIRE(r > 0);
+    if (r < 0.49) {
+      CHECK(IncrementStrainRate(increment(r), dt).upper_bound() <= rate);
+      CHECK(IncrementStrainRate(increment(r * (1 + 5e-6)), dt).upper_bound() > rate);
+    }
+  }
+  CHECK(IncrementStrainRate::increment_norm_bounded_below(1e-12, 0.002) == 0.0);  // below the bound's floor: none
+  // Across the cap's onset, for each rate law and step: the shortcut never answers otherwise than the exact check.
+  int agreed = 0, tried = 0, shortcut = 0;
+  for (RateLaw law : {RateLaw::printed, RateLaw::plausible, RateLaw::off}) {
+    TissueMaterial m;
+    m.rate_law = law;
+    for (double dt : {0.002, 0.0502, 1.0}) {
+      const double limit = uncapped_rate_limit_per_ms(m);
+      const double edge = std::isfinite(limit) ? IncrementStrainRate::increment_norm_bounded_below(limit, dt) : 0.3;
+      for (double scale : {0.01, 0.5, 0.999, 0.999999, 1.0, 1.000001, 1.001, 2.0, 1e3})
+        for (int k = 0; k < 5; ++k) {
+          const double r = std::min(edge * scale, 0.6);
+          if (!(r > 0)) continue;
+          const IncrementStrainRate rate(increment(r), dt);
+          ++tried;
+          if (rate_stays_uncapped(m, rate) == m.rate_factor_uncapped_up_to(rate.upper_bound())) ++agreed;
+          if (rate.increment_norm() < edge) ++shortcut;
+        }
+    }
+  }
+  CHECK(agreed == tried);
+  CHECK(shortcut > tried / 4);  // and it is taken
 }
 
 TEST_CASE("The stress update is objective: a rigid rotation rotates the stress", "[solver][material]") {
