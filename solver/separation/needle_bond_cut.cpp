@@ -205,10 +205,21 @@ std::vector<std::int64_t> NeedleBondCut::bonds_through_needle(const BondNetwork&
       side[static_cast<size_t>(i)] = bits;
     }
   });
-  return select_intact_bonds(bonds, [&](std::int32_t i, std::int32_t j) {
-    if (side[static_cast<size_t>(i)] & side[static_cast<size_t>(j)]) return false;
-    return passes_through(grid, x[static_cast<size_t>(i)], x[static_cast<size_t>(j)]);
-  });
+  // The scan over the compact pair list that select_intact_bonds makes, with the arrays read through local
+  // pointers: the compiler cannot tell that appending a find leaves the lists' addresses be, so it would reload
+  // them for every pair.
+  return parallel_collect_chunks<std::int64_t>(
+      static_cast<std::int64_t>(bonds.intact.size()), [&](std::int64_t begin, std::int64_t end, std::vector<std::int64_t>& found) {
+        const IntactPair* const pairs = bonds.intact.data();
+        const Bond* const all = bonds.bonds.data();
+        const std::uint8_t* const sides = side.data();
+        const Vec3d* const positions = x.data();
+        for (std::int64_t k = begin; k < end; ++k) {
+          const IntactPair pair = pairs[k];
+          if (sides[pair.i] & sides[pair.j]) continue;
+          if (!all[pair.bond].broken && passes_through(grid, positions[pair.i], positions[pair.j])) found.push_back(pair.bond);
+        }
+      });
 }
 
 void NeedleBondCut::apply(SpgTissue& tissue, const NeedleModel& needle) {
