@@ -36,23 +36,38 @@ TipGeometry short_tip(const std::string& preset, double length_mm) {
   return resolve_tip(recipe);
 }
 
+// The needle model an Insertion drives: "rigid", "fe" or "implicit", with the implicit needle's step this fraction
+// of the tissue's first stable step (0: the model's default options).
+struct NeedleChoice {
+  std::string model;
+  double implicit_step_fraction = 0;
+};
+
 // A driven insertion: needle, tissue and the coupled run, owned together.
 struct Insertion {
   FeNeedle needle;
   ContactSurface surface;
   SpgTissue tissue;
-  std::unique_ptr<NeedleModel> model;  // the FE needle, or the rigid one
+  std::unique_ptr<NeedleModel> model;
   NeedleModel& dynamics;
   CoupledInsertion run;
 
-  Insertion(const TetMesh& mesh, double mass_scaling_dt_ms, bool rigid, const InsertionProfile& profile, const Eigen::Vector3d& direction,
-            const ParticleSet& particles, const CouplingOptions& coupling, const ContactOptions& contact = {}, const CuttingOptions& cutting = {})
+  Insertion(const TetMesh& mesh, double mass_scaling_dt_ms, const NeedleChoice& choice, const InsertionProfile& profile,
+            const Eigen::Vector3d& direction, const ParticleSet& particles, const CouplingOptions& coupling, const ContactOptions& contact = {},
+            const CuttingOptions& cutting = {})
       : needle(mesh, NeedleMaterial{}, mass_scaling_dt_ms),
         surface(needle.mesh()),
         tissue(particles, TissueMaterial{}, SpgOptions{}),
-        model(make_needle_model(rigid ? "rigid" : "fe", {needle, driven_base_supports(needle.mesh(), profile, direction), std::nullopt, {}})),
+        model(make_needle_model(choice.model, {needle, driven_base_supports(needle.mesh(), profile, direction), std::nullopt,
+                                               needle_options(choice, tissue)})),
         dynamics(*model),
         run(dynamics, tissue, surface, contact, make_separation_models(SeparationOptions{}, surface), coupling, cutting) {}
+
+  static NeedleDynamicsOptions needle_options(const NeedleChoice& choice, const SpgTissue& tissue) {
+    NeedleDynamicsOptions options;
+    if (choice.implicit_step_fraction > 0) options.implicit_step_ms = choice.implicit_step_fraction * tissue.stable_time_step_ms();
+    return options;
+  }
 
   void run_to_end() {
     const double end = dynamics_end();
@@ -88,7 +103,7 @@ ParticleSet block(double length_mm, double half_height_mm, double depth_mm, doub
 TEST_CASE("A rigid needle driven into tissue with fixed sides balances energy within 2 %", "[solver][lspg][gmsh][slow]") {
   const TetMesh mesh = small_needle(short_tip("SB", 6.0), true, 0.5);
   const InsertionProfile profile = quick_profile(2.0);
-  Insertion ins(mesh, 0.0, true, profile, Eigen::Vector3d::UnitX(), block(3.0, 1.6, 1.2, 0.4, true), CouplingOptions{});
+  Insertion ins(mesh, 0.0, {"rigid"}, profile, Eigen::Vector3d::UnitX(), block(3.0, 1.6, 1.2, 0.4, true), CouplingOptions{});
   ins.profile_end_ = profile.end_time_ms();
   ins.run_to_end();
   const InsertionEnergy& e = ins.run.energy();
@@ -122,7 +137,7 @@ TEST_CASE("A free tissue block hit by a driven needle conserves momentum within 
   // steps, so this also checks the multi-rate exchange of momentum.
   const TetMesh mesh = small_needle(short_tip("SB", 6.0), true, 0.5);
   const InsertionProfile profile = quick_profile(1.5);
-  Insertion ins(mesh, 0.0, false, profile, Eigen::Vector3d::UnitX(), block(3.0, 1.6, 1.2, 0.4, false), CouplingOptions{});
+  Insertion ins(mesh, 0.0, {"fe"}, profile, Eigen::Vector3d::UnitX(), block(3.0, 1.6, 1.2, 0.4, false), CouplingOptions{});
   ins.profile_end_ = profile.end_time_ms();
   ins.run_to_end();
   const Eigen::Vector3d tissue = ins.run.tissue_momentum();
@@ -156,7 +171,7 @@ TEST_CASE("A block pressed on a sliding needle face recovers the Coulomb coeffic
   profile.accel_time_ms = 0.005;
   profile.speed_mm_per_ms = 8.0;
   profile.travel_mm = 0.25;
-  Insertion ins(mesh, 0.0, true, profile, Eigen::Vector3d::UnitY(), make_particle_lattice(box, lattice), coupling, contact);
+  Insertion ins(mesh, 0.0, {"rigid"}, profile, Eigen::Vector3d::UnitY(), make_particle_lattice(box, lattice), coupling, contact);
   const double end = profile.end_time_ms();
   double tangential = 0, normal = 0;
   while (ins.run.time_ms() < end - 1e-12) {
@@ -188,7 +203,7 @@ TEST_CASE("The subcycled, mass-scaled needle matches the plain full model's tip 
   auto tip_deflection = [&](bool subcycling, double mass_scaling, long* needle_steps, long* steps) {
     CouplingOptions coupling;
     coupling.subcycling = subcycling;
-    Insertion ins(mesh, mass_scaling, false, profile, Eigen::Vector3d::UnitX(), block(2.0, 1.6, 1.2, 0.4, true), coupling);
+    Insertion ins(mesh, mass_scaling, {"fe"}, profile, Eigen::Vector3d::UnitX(), block(2.0, 1.6, 1.2, 0.4, true), coupling);
     ins.profile_end_ = profile.end_time_ms();
     ins.run_to_end();
     const int tip = nearest_node(ins.needle.mesh(), Eigen::Vector3d(0, -0.5, 0));
@@ -232,7 +247,7 @@ TEST_CASE("Particles inside the contact skin at the start do not trip the energy
   box.faces[2] = box.faces[3] = box.faces[5] = FaceCondition::fixed;
   LatticeOptions lattice;
   lattice.spacing_mm = 0.1;
-  Insertion ins(mesh, 0.0, true, profile, Eigen::Vector3d::UnitX(), make_particle_lattice(box, lattice), CouplingOptions{});
+  Insertion ins(mesh, 0.0, {"rigid"}, profile, Eigen::Vector3d::UnitX(), make_particle_lattice(box, lattice), CouplingOptions{});
   const InsertionEnergy& e = ins.run.energy();
   REQUIRE(e.initial_penalty_energy_mJ > 0);  // the case this test is about
   const double end_ms = 0.1;
@@ -259,7 +274,7 @@ TEST_CASE("A cutting pressure loads the tip facets along their normals and the b
   CuttingOptions cutting;
   cutting.pressure_MPa = pressure_MPa;
   for (const FacetPlane& f : tip.facets) cutting.facets.push_back(f.name);
-  Insertion ins(mesh, 0.0, true, profile, Eigen::Vector3d::UnitX(), block(3.0, 1.6, 1.2, 0.4, true), CouplingOptions{}, ContactOptions{}, cutting);
+  Insertion ins(mesh, 0.0, {"rigid"}, profile, Eigen::Vector3d::UnitX(), block(3.0, 1.6, 1.2, 0.4, true), CouplingOptions{}, ContactOptions{}, cutting);
   const double end = profile.end_time_ms();
   const auto& names = ins.surface.tag_names();
   const size_t top = static_cast<size_t>(std::find(names.begin(), names.end(), "top") - names.begin());
@@ -321,7 +336,7 @@ TEST_CASE("A needle turned upside down deflects the other way by as much: the co
   auto tip_deflection = [&](const GrindingRecipe& recipe) {
     const TipGeometry tip = resolve_tip(recipe);
     const TetMesh mesh = small_needle(tip, true, 0.5);
-    Insertion ins(mesh, 1.2e-5, false, profile, Eigen::Vector3d::UnitX(), block(3.0, 1.6, 1.2, 0.4, true), CouplingOptions{});
+    Insertion ins(mesh, 1.2e-5, {"fe"}, profile, Eigen::Vector3d::UnitX(), block(3.0, 1.6, 1.2, 0.4, true), CouplingOptions{});
     ins.profile_end_ = profile.end_time_ms();
     ins.run_to_end();
     CHECK(ins.run.energy().balance_error() < 0.02);
@@ -359,14 +374,11 @@ TEST_CASE("Projection contact: a free block hit by the needle exchanges momentum
   const TetMesh mesh = small_needle(short_tip("SB", 6.0), true, 0.5);
   const InsertionProfile profile = quick_profile(1.5);
   for (const std::string model : {"fe", "implicit"}) {
-    const FeNeedle needle(mesh, NeedleMaterial{}, 0.0);
-    const ContactSurface surface(needle.mesh());
-    SpgTissue tissue(block(3.0, 1.6, 1.2, 0.4, false), TissueMaterial{}, SpgOptions{});
-    NeedleDynamicsOptions options;
-    options.implicit_step_ms = 0.25 * tissue.stable_time_step_ms();
-    const std::unique_ptr<NeedleModel> dynamics =
-        make_needle_model(model, {needle, driven_base_supports(needle.mesh(), profile, Eigen::Vector3d::UnitX()), std::nullopt, options});
-    CoupledInsertion run(*dynamics, tissue, surface, projection(), make_separation_models(SeparationOptions{}, surface), CouplingOptions{});
+    Insertion ins(mesh, 0.0, {model, 0.25}, profile, Eigen::Vector3d::UnitX(), block(3.0, 1.6, 1.2, 0.4, false), CouplingOptions{}, projection());
+    const ContactSurface& surface = ins.surface;
+    SpgTissue& tissue = ins.tissue;
+    NeedleModel& dynamics = ins.dynamics;
+    CoupledInsertion& run = ins.run;
     const double penalty_limit = PenaltyContact(surface, tissue.particles(), tissue.material(), ContactOptions{}).max_time_step_ms(0.1);
     int in_contact = 0;
     while (run.time_ms() < profile.end_time_ms() - 1e-12) {
@@ -376,8 +388,8 @@ TEST_CASE("Projection contact: a free block hit by the needle exchanges momentum
     const double mean_step = run.time_ms() / static_cast<double>(run.steps());
     const auto& contact = dynamic_cast<const ProjectionContact&>(run.contact_model());
     const Eigen::Vector3d tissue_p = run.tissue_momentum();
-    const Eigen::Vector3d balance = tissue_p + run.needle_momentum() - dynamics->drive_impulse_N_ms() + contact.pending_impulse();
-    const double lag = dynamics->time_step_ms() / run.last_step_ms() * contact.pending_impulse().norm();
+    const Eigen::Vector3d balance = tissue_p + run.needle_momentum() - dynamics.drive_impulse_N_ms() + contact.pending_impulse();
+    const double lag = dynamics.time_step_ms() / run.last_step_ms() * contact.pending_impulse().norm();
     INFO(model << ": mean step " << mean_step << " ms, penalty's " << penalty_limit << " ms; tissue momentum " << tissue_p.transpose()
                << "; imbalance " << balance.transpose() << " (a needle step of the last force: " << lag << ")");
     CHECK(in_contact > 0);
@@ -387,7 +399,7 @@ TEST_CASE("Projection contact: a free block hit by the needle exchanges momentum
     CHECK(std::abs(balance.y()) <= lag + 1e-9 * tissue_p.norm());
     // No particle inside the needle at the end: the run's own check after each step, and the level set's.
     CHECK(run.max_particles_inside() == 0);
-    CHECK(run.contact_model().classify(tissue.particles(), dynamics->positions_mm()).particles_inside == 0);
+    CHECK(run.contact_model().classify(tissue.particles(), dynamics.positions_mm()).particles_inside == 0);
     CHECK(run.energy().balance_error() < 0.01);
   }
 }
@@ -396,7 +408,7 @@ TEST_CASE("Projection contact: a rigid needle into a block with fixed sides bala
           "[solver][lspg][gmsh][slow]") {
   const TetMesh mesh = small_needle(short_tip("SB", 6.0), true, 0.5);
   const InsertionProfile profile = quick_profile(2.0);
-  Insertion ins(mesh, 0.0, true, profile, Eigen::Vector3d::UnitX(), block(3.0, 1.6, 1.2, 0.4, true), CouplingOptions{}, projection());
+  Insertion ins(mesh, 0.0, {"rigid"}, profile, Eigen::Vector3d::UnitX(), block(3.0, 1.6, 1.2, 0.4, true), CouplingOptions{}, projection());
   ins.profile_end_ = profile.end_time_ms();
   double least_dissipation = 0;
   while (ins.run.time_ms() < profile.end_time_ms() - 1e-12) {
@@ -437,7 +449,7 @@ TEST_CASE("Tissue mass scaling: a needle into a block at 1.5 times the tissue's 
     CouplingOptions coupling;
     const double first_step = SpgTissue(particles, TissueMaterial{}, SpgOptions{}).stable_time_step_ms();
     if (scaled) coupling.tissue_mass_scaling_dt_ms = 1.5 * first_step;
-    Insertion ins(mesh, 0.0, true, profile, Eigen::Vector3d::UnitX(), particles, coupling, projection());
+    Insertion ins(mesh, 0.0, {"rigid"}, profile, Eigen::Vector3d::UnitX(), particles, coupling, projection());
     while (ins.run.time_ms() < profile.end_time_ms() - 1e-12) ins.run.step(profile.end_time_ms());
     const InsertionEnergy& e = ins.run.energy();
     drive_work[scaled] = e.drive_work_mJ;
@@ -472,17 +484,13 @@ TEST_CASE("The tissue's stresses away from the needle, updated beside the needle
   std::vector<std::vector<Eigen::Vector3d>> particles;
   std::vector<Eigen::MatrixX3d> nodes;
   for (const double margin : {-1.0, 0.1, 0.0}) {  // -1: one after the other
-    const FeNeedle needle(mesh, NeedleMaterial{}, 0.0);
-    const ContactSurface surface(needle.mesh());
-    SpgTissue tissue(block(3.0, 1.6, 1.2, 0.4, false), TissueMaterial{}, SpgOptions{});
-    NeedleDynamicsOptions options;
-    options.implicit_step_ms = 0.5 * tissue.stable_time_step_ms();
-    const std::unique_ptr<NeedleModel> dynamics =
-        make_needle_model("implicit", {needle, driven_base_supports(needle.mesh(), profile, Eigen::Vector3d::UnitX()), std::nullopt, options});
     CouplingOptions coupling;
     coupling.tissue_beside_needle = margin >= 0;
     coupling.tissue_ahead_margin_mm = std::max(margin, 0.0);
-    CoupledInsertion run(*dynamics, tissue, surface, projection(), make_separation_models(SeparationOptions{}, surface), coupling);
+    Insertion ins(mesh, 0.0, {"implicit", 0.5}, profile, Eigen::Vector3d::UnitX(), block(3.0, 1.6, 1.2, 0.4, false), coupling, projection());
+    SpgTissue& tissue = ins.tissue;
+    NeedleModel& dynamics = ins.dynamics;
+    CoupledInsertion& run = ins.run;
     int in_contact = 0;
     while (run.time_ms() < profile.end_time_ms() - 1e-12) {
       run.step(profile.end_time_ms());
@@ -491,7 +499,7 @@ TEST_CASE("The tissue's stresses away from the needle, updated beside the needle
     INFO("margin " << margin << ": " << run.steps() << " steps, " << in_contact << " particles in contact at most");
     CHECK(in_contact > 0);
     particles.push_back(tissue.particles().position_mm);
-    nodes.push_back(dynamics->positions_mm());
+    nodes.push_back(dynamics.positions_mm());
   }
   for (size_t k = 1; k < particles.size(); ++k) {
     CHECK(particles[k] == particles[0]);
