@@ -93,16 +93,20 @@ bool rate_stays_uncapped(const TissueMaterial& m, const IncrementStrainRate& rat
   return m.rate_factor_uncapped_up_to(rate.upper_bound());
 }
 
+bool mat018_trial_stays_elastic(const TissueMaterial& m, const IncrementStrainRate& rate, double q_trial, double eps_p) {
+  // The rate factor is at least 1 and only raises the yield stress: a trial within the yield stress at factor 1 is
+  // elastic at any rate, and where the rate cannot reach the factor's cap either, the rate is not needed (most
+  // particles, most steps: it is an eigenvalue problem).
+  return (q_trial <= card_constants(m).initial_yield_floor_MPa || q_trial <= m.yield_stress_MPa(eps_p, 1.0)) &&
+         rate_stays_uncapped(m, rate);
+}
+
 Eigen::Vector3d mat018_deviatoric_stress(const TissueMaterial& m, const IncrementStrainRate& rate, const Eigen::Vector3d& h_dev,
                                          Eigen::Vector3d& h, double& eps_p, bool& capped) {
   const double mu = m.shear_modulus_MPa();
   Eigen::Vector3d s = 2 * mu * h_dev;  // principal deviatoric Cauchy stress
   const double q_trial = std::sqrt(1.5 * s.squaredNorm());
-  // The rate factor is at least 1 and only raises the yield stress: a trial within the yield stress at factor 1 is
-  // elastic at any rate, and where the rate cannot reach the factor's cap either, the rate is not needed (most
-  // particles, most steps: it is an eigenvalue problem).
-  if ((q_trial <= card_constants(m).initial_yield_floor_MPa || q_trial <= m.yield_stress_MPa(eps_p, 1.0)) &&
-      rate_stays_uncapped(m, rate)) {
+  if (mat018_trial_stays_elastic(m, rate, q_trial, eps_p)) {
     capped = false;
     return s;
   }

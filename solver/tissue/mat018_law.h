@@ -15,6 +15,10 @@ namespace needle {
 Eigen::Vector3d mat018_deviatoric_stress(const TissueMaterial& m, const IncrementStrainRate& rate, const Eigen::Vector3d& h_dev,
                                          Eigen::Vector3d& h, double& eps_p, bool& capped);
 
+// Whether a trial of von Mises stress q_trial stays elastic at any rate: within the yield stress at rate factor 1
+// (the factor only raises it) with the rate unable to reach the factor's cap (rate_stays_uncapped), so the rate
+// itself is not needed. mat018_deviatoric_stress returns 2 mu h_dev, uncapped, where this holds.
+bool mat018_trial_stays_elastic(const TissueMaterial& m, const IncrementStrainRate& rate, double q_trial, double eps_p);
 // Whether the rate factor stays below its cap over the increment, as m.rate_factor_uncapped_up_to(rate.upper_bound())
 // says: without its two logarithms where |f f^T - I| lies below the norm at which the bound could reach the cap
 // (both rise with the norm; the same answer, for the same results to the last bit).

@@ -9,10 +9,12 @@ double TissueMaterial::equivalent_stress_MPa(double eps) const {
   return 3 * shear_modulus_MPa() * eps + k_MPa * std::pow(std::max(eps, 0.0), n);
 }
 
+double stiffening_elastic_secant_shear_modulus_MPa(const TissueMaterial& m, double eps_eq) {
+  return eps_eq > 0 ? m.equivalent_stress_MPa(eps_eq) / (3 * eps_eq) : m.shear_modulus_MPa();
+}
+
 Eigen::Vector3d stiffening_elastic_deviatoric_stress(const TissueMaterial& m, const Eigen::Vector3d& h_dev, double eps_eq) {
-  // Secant shear modulus: q(eps) / (3 eps); the small-strain G at eps = 0.
-  const double secant_mu = eps_eq > 0 ? m.equivalent_stress_MPa(eps_eq) / (3 * eps_eq) : m.shear_modulus_MPa();
-  return 2 * secant_mu * h_dev;
+  return 2 * stiffening_elastic_secant_shear_modulus_MPa(m, eps_eq) * h_dev;
 }
 
 double stiffening_elastic_uniaxial_true_stress_MPa(const TissueMaterial& m, double true_strain) {

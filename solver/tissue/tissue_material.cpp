@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "core/input_error.h"
+#include "solver/tissue/hencky_strain.h"
 #include "solver/tissue/maxwell_relaxation.h"
 #include "solver/tissue/mat018_law.h"
 #include "solver/tissue/stiffening_elastic_law.h"
@@ -105,8 +106,52 @@ double IncrementStrainRate::increment_norm_bounded_below(double rate_per_ms, dou
   return std::min(r, 0.5) * (1 - 1e-6);
 }
 
+namespace {
+
+// The update of a trial that stays elastic, from its Hencky strain H = 1/2 ln(b_trial) as a matrix: each law's
+// deviatoric stress is then a multiple of dev H (2 mu, or the stiffening law's secant 2 mu_s), and b_e is the
+// trial itself (exp(2 H) = b_trial). False where MAT_018 would flow or its rate could reach the cap.
+bool update_elastic_trial(const TissueMaterial& m, const MaterialPoint& state, const Eigen::Matrix3d& f, double dt_ms,
+                          const Eigen::Matrix3d& b_trial, const Eigen::Matrix3d& H, const IncrementStrainRate& rate, StressUpdate& out) {
+  const double mu = m.shear_modulus_MPa(), lambda = m.lame_lambda_MPa();
+  const double volumetric = H.trace();
+  Eigen::Matrix3d H_dev = H;
+  H_dev.diagonal().array() -= volumetric / 3.0;
+  const double eps_eq = std::sqrt(2.0 / 3.0 * H_dev.squaredNorm());
+  double shear_factor = 0;  // the deviatoric stress per unit dev H
+  switch (m.law) {
+    case TissueLaw::mat018:
+      if (!mat018_trial_stays_elastic(m, rate, std::sqrt(1.5) * 2 * mu * H_dev.norm(), state.plastic_strain)) return false;
+      shear_factor = 2 * mu;
+      break;
+    case TissueLaw::stiffening_elastic: shear_factor = 2 * stiffening_elastic_secant_shear_modulus_MPa(m, eps_eq); break;
+  }
+  const Eigen::Matrix3d s = shear_factor * H_dev;
+  out.state.elastic_left_cauchy_green = 0.5 * (b_trial + b_trial.transpose());
+  out.state.plastic_strain = state.plastic_strain;
+  out.cauchy_stress_MPa = s;
+  out.cauchy_stress_MPa.diagonal().array() += (lambda + 2.0 * mu / 3.0) * volumetric;
+  if (m.viscoelastic()) {
+    maxwell_relax(m, f, dt_ms, s, state, out.state);
+    out.cauchy_stress_MPa -= out.state.relaxed_stress_MPa;
+  }
+  out.rate_factor_capped = false;
+  out.effective_strain = state.plastic_strain + eps_eq;
+  return true;
+}
+
+}  // namespace
+
 StressUpdate update_stress(const TissueMaterial& m, const MaterialPoint& state, const Eigen::Matrix3d& f, double dt_ms) {
-  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  const Eigen::Matrix3d b_trial = f * state.elastic_left_cauchy_green * f.transpose();
+  Eigen::Matrix3d H;
+  StressUpdate out;
+  if (hencky_strain_near_identity(b_trial, H) && update_elastic_trial(m, state, f, dt_ms, b_trial, H, IncrementStrainRate(f, dt_ms), out))
+    return out;
+  return update_stress_by_eigenvalues(m, state, f, dt_ms);
+}
+
+StressUpdate update_stress_by_eigenvalues(const TissueMaterial& m, const MaterialPoint& state, const Eigen::Matrix3d& f, double dt_ms) {
   // Elastic trial: b_e = f b_e f^T, principal log strains.
   const Eigen::Matrix3d b_trial = f * state.elastic_left_cauchy_green * f.transpose();
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
@@ -143,7 +188,6 @@ StressUpdate update_stress(const TissueMaterial& m, const MaterialPoint& state, 
   out.rate_factor_capped = capped;
   const Eigen::Vector3d h_dev_final = h.array() - h.mean();
   out.effective_strain = eps_p + std::sqrt(2.0 / 3.0 * h_dev_final.squaredNorm());
-  (void)I;
   return out;
 }
 

@@ -135,8 +135,14 @@ struct StressUpdate {
 
 // One increment with relative deformation gradient f = F_n+1 F_n^-1 over dt_ms (> 0 gives the strain
 // rate of the rate law, from the deviatoric part of ln(f f^T) / 2).
+// Where the trial b_e = f b_e f^T lies near the identity (hencky_strain.h) and the law stays elastic, the update
+// works with h as a matrix and needs no eigenvalues; elsewhere it works in h's principal axes
+// (update_stress_by_eigenvalues), as a law that flows must. The two agree to rounding.
 StressUpdate update_stress(const TissueMaterial& material, const MaterialPoint& state, const Eigen::Matrix3d& relative_F,
                            double dt_ms);
+// The same update, always in the principal axes of the trial's eigenvalue problem (for tests).
+StressUpdate update_stress_by_eigenvalues(const TissueMaterial& material, const MaterialPoint& state, const Eigen::Matrix3d& relative_F,
+                                          double dt_ms);
 
 // The closed-form uniaxial curve of the card: Cauchy (true) stress at a true (log) strain pulled at a
 // constant true strain rate (elastic to the rate-scaled yield, then on sigma_y(eps - sigma / E)). A scalar
