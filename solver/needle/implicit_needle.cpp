@@ -203,7 +203,7 @@ void ImplicitNeedle::step(double dt, NeedleLoads& loads) {
     rhs[f] = load_[d] + cannula_load_[d] - m * accel * e[d % 3] + m * (c0 * w_[d] + c1 * wd_[d] + wdd_[d]);
   }
   Eigen::VectorXd w_free = factor.llt.solve(rhs);
-  if (cannula_) hold_in_cannula(factor, w_free, supports_.profile.displacement_mm(t1) * e);
+  const double spring_energy_term = cannula_ ? hold_in_cannula(factor, w_free, supports_.profile.displacement_mm(t1) * e) : 0.0;
   if (!w_free.allFinite()) throw SolverError(fmt::format("the implicit needle's state became non-finite at t = {:.6g} ms", t1));
   Eigen::VectorXd dw = Eigen::VectorXd::Zero(w_.size());
   for (Eigen::Index f = 0; f < nf; ++f) {
@@ -237,7 +237,12 @@ void ImplicitNeedle::step(double dt, NeedleLoads& loads) {
   old_load_ = load_;
   old_cannula_load_ = cannula_load_;
   energy_.kinetic_mJ = 0.5 * mass_.dot(v_.rowwise().squaredNorm());
-  energy_.strain_mJ = 0.5 * w_.dot(stiffness_times(w_));
+  // 1/2 w.K w from the equation just solved, (K + c0 M + U U^T) w = rhs + g on the free components (w = 0 on the
+  // held ones): K w = rhs - c0 M w + (g - U U^T w), without a product with K. The springs' part is
+  // hold_in_cannula's.
+  double work = spring_energy_term;
+  for (Eigen::Index f = 0; f < nf; ++f) work += w_free[f] * (rhs[f] - c0 * mass_free_[f] * w_free[f]);
+  energy_.strain_mJ = 0.5 * work;
   ++steps_;
   if (!std::isfinite(energy_.kinetic_mJ) || !std::isfinite(energy_.strain_mJ))
     throw SolverError(fmt::format("the needle's energy became non-finite at t = {:.6g} ms", time_ms_));
@@ -255,7 +260,7 @@ const Eigen::VectorXd& ImplicitNeedle::column(Factor& factor, int dof) {
   return factor.columns.emplace(dof, factor.llt.solve(unit)).first->second;
 }
 
-void ImplicitNeedle::hold_in_cannula(Factor& factor, Eigen::VectorXd& w, const Eigen::Vector3d& drive) {
+double ImplicitNeedle::hold_in_cannula(Factor& factor, Eigen::VectorXd& w, const Eigen::Vector3d& drive) {
   const double r_in = cannula_->inner_radius_mm(), back = cannula_->front_x_mm - cannula_->length_mm, front = cannula_->front_x_mm;
   const Eigen::MatrixX3d& X = needle_.mesh().X;
   const Eigen::VectorXd w_free = w;  // without the cannula
@@ -290,6 +295,7 @@ void ImplicitNeedle::hold_in_cannula(Factor& factor, Eigen::VectorXd& w, const E
       tried[k] = 1;
     }
   Eigen::VectorXd solved = w_free;
+  double energy_term = 0;  // (g - U U^T w).w for the set that gave `solved`
   for (int iteration = 0; iteration < 10 && !active.empty(); ++iteration) {
     // Z = A^-1 U, U's column a = sqrt(k_a) n_a on node a's free components; the springs' constant part
     // k (r - n.(X + d e)) n joins the right-hand side, as the sum of its A^-1 columns.
@@ -323,6 +329,16 @@ void ImplicitNeedle::hold_in_cannula(Factor& factor, Eigen::VectorXd& w, const E
     Eigen::MatrixXd S = Eigen::MatrixXd::Identity(na, na);
     for (Eigen::Index b = 0; b < na; ++b) S.col(b) += project(Z.col(b));
     solved = shifted - Z * S.ldlt().solve(project(shifted));
+    // Each spring's k (offset - n.w) (n.w) on its node's free components.
+    energy_term = 0;
+    for (const Spring& s : active) {
+      double along = 0;
+      for (int k = 1; k < 3; ++k) {
+        const int f = free_index_[3 * static_cast<size_t>(s.node) + k];
+        if (f >= 0) along += s.normal[k] * solved[f];
+      }
+      energy_term += s.k * (r_in - s.normal.dot(X.row(s.node).transpose() + drive) - along) * along;
+    }
     // The set holds when no spring pulls and no node not yet tried passes the bore.
     std::vector<Spring> next;
     for (const Spring& s : active)
@@ -357,6 +373,7 @@ void ImplicitNeedle::hold_in_cannula(Factor& factor, Eigen::VectorXd& w, const E
   if (contact_.max_penetration_mm > options_.max_penetration_mm)
     throw SolverError(fmt::format("the needle passed the cannula's bore by {:.3g} mm at t = {:.6g} ms (limit {:.3g} mm): "
                                   "runaway penetration", contact_.max_penetration_mm, time_ms_, options_.max_penetration_mm));
+  return energy_term;
 }
 
 void ImplicitNeedle::add_summary(nlohmann::json& summary) const {

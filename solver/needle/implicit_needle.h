@@ -26,7 +26,7 @@
 // turn by about 0.05 rad: a relative error of order 1e-3), and the period error of the trapezoidal rule,
 // (omega h)^2 / 12, about 1e-6 for the first bending mode at h = 1e-3 ms. Measured in the tests against the
 // FE needle under a static and a dynamic tip load.
-// Energy: kinetic + strain (1/2 w.K w) = work of the drive's reaction (from the needle's momentum balance),
+// Energy: kinetic + strain (1/2 w.K w, from the step's own equation: no product with K) = work of the drive's reaction (from the needle's momentum balance),
 // the cannula's and the external loads' (trapezoid of the held forces over each step); the run stops with
 // a SolverError beyond max_energy_error, on a non-finite state or on cannula penetration beyond its bound.
 #include <Eigen/Dense>
@@ -78,8 +78,9 @@ class ImplicitNeedle : public NeedleModel {
   // The held loads at the current state: the contact's (loads) into load_, the cannula's friction into cannula_load_.
   void evaluate_loads(NeedleLoads& loads);
   // The cannula's normal springs on the free components solved into w (free components), iterating the set of
-  // nodes in contact; their forces at t + dt are added to cannula_load_. drive_mm: d(t + dt) e.
-  void hold_in_cannula(Factor& factor, Eigen::VectorXd& w, const Eigen::Vector3d& drive_mm);
+  // nodes in contact; their forces at t + dt are added to cannula_load_. drive_mm: d(t + dt) e. Returns the
+  // springs' (g - U U^T w).w of the system solved last (step's strain energy).
+  double hold_in_cannula(Factor& factor, Eigen::VectorXd& w, const Eigen::Vector3d& drive_mm);
   const Eigen::VectorXd& column(Factor& factor, int dof);  // A^-1 e_dof on the free components, cached
   void update_state();        // x_, v_ from w, w' and the drive
   void start_accelerations();  // w'' in equilibrium with the held loads at the current state
@@ -98,7 +99,7 @@ class ImplicitNeedle : public NeedleModel {
   double max_cannula_penetration_mm_ = 0;
   std::vector<int> free_dof_;              // free components, as 3 node + axis
   Eigen::SparseMatrix<double> K_;          // full stiffness (strain energy, reactions)
-  Eigen::SparseMatrix<double, Eigen::RowMajor> K_rows_;  // the same by rows, for K w in parallel
+  Eigen::SparseMatrix<double, Eigen::RowMajor> K_rows_;  // the same by rows, for K w in parallel (the first accelerations)
   Eigen::VectorXd stiffness_times(const Eigen::VectorXd& w) const;  // K w, the same bits as K_ * w
   Eigen::SparseMatrix<double> K_free_;     // on the free components, lower triangle
   Eigen::VectorXd mass_free_;

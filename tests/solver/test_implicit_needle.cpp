@@ -51,6 +51,15 @@ struct TipLoad : NeedleLoads {
   }
 };
 
+// 1/2 u.K u from the FE needle's own stiffness matrix (K annihilates the drive's rigid motion): what the model
+// reports as its strain energy without multiplying by K.
+double strain_energy_by_stiffness(const FeNeedle& fe, const ImplicitNeedle& model) {
+  const Eigen::MatrixX3d u = model.displacements_mm();
+  Eigen::VectorXd flat(3 * u.rows());
+  for (Eigen::Index i = 0; i < u.rows(); ++i) flat.segment<3>(3 * i) = u.row(i).transpose();
+  return 0.5 * flat.dot(fe.stiffness_matrix() * flat);
+}
+
 double mean_tip_y(const NeedleModel& model, const std::vector<int>& nodes) {
   double sum = 0;
   for (int n : nodes) sum += model.positions_mm()(n, 1) - model.mesh().X(n, 1);
@@ -136,6 +145,7 @@ TEST_CASE("Implicit needle: a tip load applied at once swings as the explicit FE
   INFO("implicit energy: kinetic " << implicit.energy().kinetic_mJ << " strain " << implicit.energy().strain_mJ << " external work "
                                    << implicit.energy().external_work_mJ);
   CHECK(implicit.energy().external_work_mJ > 0);
+  CHECK(implicit.energy().strain_mJ == Approx(strain_energy_by_stiffness(fe, implicit)).epsilon(1e-9));
   CHECK(implicit.energy().balance_error() < 1e-6);
   CHECK(shorter.energy().balance_error() < 1e-6);
   CHECK(shorter.factorizations() == 1);
@@ -217,4 +227,8 @@ TEST_CASE("Implicit needle: a rod pressed against the cannula's bore is held the
   CHECK(a == Approx(b).epsilon(0.02));
   CHECK(a_front == Approx(b_front).epsilon(0.05));
   CHECK(implicit.max_cannula_penetration_mm() < 1e-3);
+  // The strain energy from the step's own equation, with the cannula's springs in it, is 1/2 u.K u.
+  CHECK(implicit.cannula_contact().nodes_in_contact > 0);
+  CHECK(implicit.energy().strain_mJ > 0);
+  CHECK(implicit.energy().strain_mJ == Approx(strain_energy_by_stiffness(fe, implicit)).epsilon(1e-9));
 }
