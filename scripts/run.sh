@@ -5,7 +5,8 @@
 # paper's report (the four coupled insertions) into out/, and print the speed-against-error benchmarks.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/build.sh
+# The command and the benchmarks this job runs (scripts/test.sh builds the tests as well).
+bash scripts/build.sh needle bench_tip bench_mesh bench_spg bench_needle bench_insertion
 mkdir -p out
 for preset in SB LMB AMB HMB; do
   ./build/apps/needle tip --preset "$preset" --json --out "out/$preset.stl" > "out/$preset.json"
@@ -34,14 +35,16 @@ cat out/bench_levels/speed_error.csv
 # 1.5–2 minutes a needle on 2 cores. A run the solver stops is reported as such in the report, not an error of the main job.
 # The report sets beside it, from their stored reports in docs/notebook/paper_results/: the full model (the default
 # before, calibrated on SB with itself, E 0.078; `--model full`, 21–23 min a needle) and the fast level before its
-# ellipsoidal supports (at the full model's E). Two replicas of the default model, its runs repeated with the particle
-# lattice shifted 0.1 and 0.05 mm against the needle's path (docs/notebook/scripts/scatter_study.sh), give each
+# ellipsoidal supports (at the full model's E). Three replicas of the default model, its runs repeated with the particle
+# lattice shifted 0.1 and 0.05 mm against the needle's path (docs/notebook/scripts/scatter_study.sh) and its runs before
+# the elastic stress update took the Hencky strain from a series (the same model, other rounding), give each
 # deflection's run-to-run scatter and the targets that hold in every replica.
 ./build/apps/needle paper --calibration data/paper/calibration_sb.json --out out/paper --label "the fast model (default), calibrated on SB" \
   --compare "the full model (the default before), E 0.078=docs/notebook/paper_results/full_model/results.json" \
   --compare "the fast model with spherical supports, E 0.078=docs/notebook/paper_results/fast_model/results.json" \
   --replica "lattice +0.1 mm=docs/notebook/paper_results/fast_lattice_shift_0.1mm/results.json" \
-  --replica "lattice +0.05 mm=docs/notebook/paper_results/fast_lattice_shift_0.05mm/results.json"
+  --replica "lattice +0.05 mm=docs/notebook/paper_results/fast_lattice_shift_0.05mm/results.json" \
+  --replica "eigenvalue Hencky strain (other rounding)=docs/notebook/paper_results/fast_eigenvalue_rounding/results.json"
 echo "results in out/: <preset>.json (report), <preset>.stl, <preset>_half.glb, <preset>.png,"
 echo "  <preset>_half_t10.msh/.vtu + <preset>_mesh.json (T10 mesh and its report), tissue_particles.vtp/.json,"
 echo "  material_test.csv/.png/.json (the tissue card in uniaxial tension), stiffness_<preset>.json (tip compliance"
