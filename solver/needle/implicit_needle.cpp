@@ -8,7 +8,6 @@
 #include <nlohmann/json.hpp>
 
 #include "core/input_error.h"
-#include "core/parallel.h"
 #include "core/solver_error.h"
 
 namespace needle {
@@ -47,7 +46,6 @@ ImplicitNeedle::ImplicitNeedle(const FeNeedle& needle, NeedleSupports supports, 
       free_dof_.push_back(d);
     }
   K_ = needle.stiffness_matrix();
-  K_rows_ = K_;
   std::vector<Eigen::Triplet<double>> triplets;
   triplets.reserve(static_cast<size_t>(K_.nonZeros() / 2 + free_dof_.size()));
   for (int col = 0; col < K_.outerSize(); ++col)
@@ -130,26 +128,11 @@ void ImplicitNeedle::apply_loads(NeedleLoads& loads) {
   start_accelerations();
 }
 
-Eigen::VectorXd ImplicitNeedle::stiffness_times(const Eigen::VectorXd& w) const {
-  // By rows in parallel, each row's entries summed in increasing column order from zero: the order in which the
-  // column-major product adds them, so the same result to the last bit, for any thread count.
-  Eigen::VectorXd out(w.size());
-  parallel_for(K_rows_.outerSize(), [&](std::int64_t begin, std::int64_t end) {
-    for (std::int64_t r = begin; r < end; ++r) {
-      double sum = 0;
-      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(K_rows_, static_cast<Eigen::Index>(r)); it; ++it)
-        sum += it.value() * w[it.index()];
-      out[static_cast<Eigen::Index>(r)] = sum;
-    }
-  });
-  return out;
-}
-
 void ImplicitNeedle::start_accelerations() {
   // M w'' = f - K w - M e d'' with the drive's acceleration over the first step.
   const double h = step_ms_;
   const double accel = (supports_.profile.velocity_mm_per_ms(time_ms_ + h) - supports_.profile.velocity_mm_per_ms(time_ms_)) / h;
-  const Eigen::VectorXd elastic = stiffness_times(w_);
+  const Eigen::VectorXd elastic = K_ * w_;
   for (size_t f = 0; f < free_dof_.size(); ++f) {
     const int d = free_dof_[f];
     wdd_[d] = (load_[d] + cannula_load_[d] - elastic[d]) / mass_[d / 3] - accel * supports_.direction[d % 3];
@@ -277,6 +260,7 @@ double ImplicitNeedle::hold_in_cannula(Factor& factor, Eigen::VectorXd& w, const
     int node;
     double k;
     Eigen::Vector3d normal;  // radial, outward, at the state it joined
+    double offset;           // r - n.(X + d e): the spring's force is k (offset - n.w) n
   };
   const auto passes = [&](size_t k, const Eigen::VectorXd& wf) {
     const Eigen::Vector3d p = position(cannula_nodes_[k], wf);
@@ -285,7 +269,8 @@ double ImplicitNeedle::hold_in_cannula(Factor& factor, Eigen::VectorXd& w, const
   const auto spring = [&](size_t k, const Eigen::VectorXd& wf) {
     const Eigen::Vector3d p = position(cannula_nodes_[k], wf);
     const double r = std::hypot(p.y(), p.z());
-    return Spring{cannula_nodes_[k], cannula_k_[k], Eigen::Vector3d(0, p.y() / r, p.z() / r)};
+    const Eigen::Vector3d normal(0, p.y() / r, p.z() / r);
+    return Spring{cannula_nodes_[k], cannula_k_[k], normal, r_in - normal.dot(X.row(cannula_nodes_[k]).transpose() + drive)};
   };
   std::vector<Spring> active;
   std::vector<std::uint8_t> tried(cannula_nodes_.size(), 0);
@@ -304,13 +289,12 @@ double ImplicitNeedle::hold_in_cannula(Factor& factor, Eigen::VectorXd& w, const
     Eigen::VectorXd shifted = w_free;
     for (Eigen::Index a = 0; a < na; ++a) {
       const Spring& s = active[static_cast<size_t>(a)];
-      const double offset = r_in - s.normal.dot(X.row(s.node).transpose() + drive);
       for (int k = 1; k < 3; ++k) {
         const int dof = 3 * s.node + k;
         if (free_index_[static_cast<size_t>(dof)] < 0 || s.normal[k] == 0) continue;
         const Eigen::VectorXd& c = column(factor, dof);
         Z.col(a) += std::sqrt(s.k) * s.normal[k] * c;
-        shifted += s.k * offset * s.normal[k] * c;
+        shifted += s.k * s.offset * s.normal[k] * c;
       }
     }
     const auto project = [&](const Eigen::VectorXd& v) {  // U^T v: sqrt(k_a) n_a . v on node a
@@ -337,7 +321,7 @@ double ImplicitNeedle::hold_in_cannula(Factor& factor, Eigen::VectorXd& w, const
         const int f = free_index_[3 * static_cast<size_t>(s.node) + k];
         if (f >= 0) along += s.normal[k] * solved[f];
       }
-      energy_term += s.k * (r_in - s.normal.dot(X.row(s.node).transpose() + drive) - along) * along;
+      energy_term += s.k * (s.offset - along) * along;
     }
     // The set holds when no spring pulls and no node not yet tried passes the bore.
     std::vector<Spring> next;

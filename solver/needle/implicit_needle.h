@@ -98,9 +98,7 @@ class ImplicitNeedle : public NeedleModel {
   CannulaContact contact_;
   double max_cannula_penetration_mm_ = 0;
   std::vector<int> free_dof_;              // free components, as 3 node + axis
-  Eigen::SparseMatrix<double> K_;          // full stiffness (strain energy, reactions)
-  Eigen::SparseMatrix<double, Eigen::RowMajor> K_rows_;  // the same by rows, for K w in parallel (the first accelerations)
-  Eigen::VectorXd stiffness_times(const Eigen::VectorXd& w) const;  // K w, the same bits as K_ * w
+  Eigen::SparseMatrix<double> K_;          // full stiffness (the accelerations in equilibrium with the loads)
   Eigen::SparseMatrix<double> K_free_;     // on the free components, lower triangle
   Eigen::VectorXd mass_free_;
   std::vector<std::pair<double, std::unique_ptr<Factor>>> factors_;  // by step, the last used first

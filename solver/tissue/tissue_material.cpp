@@ -140,27 +140,14 @@ bool update_elastic_trial(const TissueMaterial& m, const MaterialPoint& state, c
   return true;
 }
 
-}  // namespace
-
-StressUpdate update_stress(const TissueMaterial& m, const MaterialPoint& state, const Eigen::Matrix3d& f, double dt_ms) {
-  const Eigen::Matrix3d b_trial = f * state.elastic_left_cauchy_green * f.transpose();
-  Eigen::Matrix3d H;
-  StressUpdate out;
-  if (hencky_strain_near_identity(b_trial, H) && update_elastic_trial(m, state, f, dt_ms, b_trial, H, IncrementStrainRate(f, dt_ms), out))
-    return out;
-  return update_stress_by_eigenvalues(m, state, f, dt_ms);
-}
-
-StressUpdate update_stress_by_eigenvalues(const TissueMaterial& m, const MaterialPoint& state, const Eigen::Matrix3d& f, double dt_ms) {
-  // Elastic trial: b_e = f b_e f^T, principal log strains.
-  const Eigen::Matrix3d b_trial = f * state.elastic_left_cauchy_green * f.transpose();
+// The update in the principal axes of the elastic trial b_trial = f b_e f^T, with the increment's effective strain
+// rate (from the deviatoric log strain of f f^T: the law asks for it).
+StressUpdate update_in_principal_axes(const TissueMaterial& m, const MaterialPoint& state, const Eigen::Matrix3d& f, double dt_ms,
+                                      const Eigen::Matrix3d& b_trial, const IncrementStrainRate& rate) {
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
   eig.computeDirect(b_trial);
   const Eigen::Vector3d lambda_sq = eig.eigenvalues().cwiseMax(1e-300);
   Eigen::Vector3d h = 0.5 * lambda_sq.array().log().matrix();
-
-  // Effective strain rate of the increment, from the deviatoric log strain of f f^T: the law asks for it.
-  const IncrementStrainRate rate(f, dt_ms);
   bool capped = false;
 
   const double mu = m.shear_modulus_MPa(), lambda = m.lame_lambda_MPa();
@@ -189,6 +176,21 @@ StressUpdate update_stress_by_eigenvalues(const TissueMaterial& m, const Materia
   const Eigen::Vector3d h_dev_final = h.array() - h.mean();
   out.effective_strain = eps_p + std::sqrt(2.0 / 3.0 * h_dev_final.squaredNorm());
   return out;
+}
+
+}  // namespace
+
+StressUpdate update_stress(const TissueMaterial& m, const MaterialPoint& state, const Eigen::Matrix3d& f, double dt_ms) {
+  const Eigen::Matrix3d b_trial = f * state.elastic_left_cauchy_green * f.transpose();
+  const IncrementStrainRate rate(f, dt_ms);
+  Eigen::Matrix3d H;
+  StressUpdate out;
+  if (hencky_strain_near_identity(b_trial, H) && update_elastic_trial(m, state, f, dt_ms, b_trial, H, rate, out)) return out;
+  return update_in_principal_axes(m, state, f, dt_ms, b_trial, rate);
+}
+
+StressUpdate update_stress_by_eigenvalues(const TissueMaterial& m, const MaterialPoint& state, const Eigen::Matrix3d& f, double dt_ms) {
+  return update_in_principal_axes(m, state, f, dt_ms, f * state.elastic_left_cauchy_green * f.transpose(), IncrementStrainRate(f, dt_ms));
 }
 
 double uniaxial_true_stress_MPa(const TissueMaterial& m, double true_strain, double strain_rate_per_ms) {
