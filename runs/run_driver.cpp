@@ -15,6 +15,7 @@ void drive_run(const Scene& scene, const RunOptions& o, const std::function<std:
   const ThreadLimit threads(o.threads >= 0 ? o.threads : scene.solver.threads);
   const auto start = Clock::now();
   const InterruptWatch interrupts;  // Ctrl-C or SIGTERM: stop between steps and write what there is
+  RunFolder::check_target(o.out_dir, o.overwrite);  // a bad --out is refused before the seconds of setup
   const std::unique_ptr<RunModel> built = build();
   RunModel& model = *built;
   if (const int signal = interrupts.signal())

@@ -28,26 +28,37 @@ bool holds_run(const std::filesystem::path& folder) {
   return fs::is_directory(folder) && (fs::exists(folder / kMarker) || (fs::exists(folder / "summary.json") && fs::exists(folder / "scene.json")));
 }
 
-}  // namespace
-
-RunFolder::RunFolder(const std::string& dir, bool overwrite) : final_(dir), overwrite_(overwrite) {
+// The folder that will hold DIR, after the checks of RunFolder::check_target.
+std::filesystem::path checked_parent(const std::string& dir, bool overwrite) {
   namespace fs = std::filesystem;
   NEEDLE_REQUIRE(!dir.empty(), "--out needs a folder");
-  const fs::path target = fs::weakly_canonical(fs::absolute(final_));
+  const fs::path folder(dir);
+  const fs::path target = fs::weakly_canonical(fs::absolute(folder));
   // "." and ".." name the folder itself: its parent is the one above.
   const fs::path parent = target.has_parent_path() && target != target.root_path() ? target.parent_path() : target;
   NEEDLE_REQUIRE(fs::is_directory(parent), fmt::format("the folder '{}' that should hold '{}' does not exist", parent.string(), dir));
-  if (fs::exists(final_)) {
+  if (fs::exists(folder)) {
     NEEDLE_REQUIRE(overwrite, fmt::format("'{}' already exists; choose another --out or pass --overwrite", dir));
     // --overwrite replaces a run the toolkit wrote, and nothing else: never the current folder or one above it.
     const fs::path cwd = fs::weakly_canonical(fs::current_path());
     const auto [end, unused] = std::mismatch(target.begin(), target.end(), cwd.begin(), cwd.end());
     NEEDLE_REQUIRE(end != target.end() && target != target.root_path(),
                    fmt::format("--overwrite would replace '{}', which holds the current folder; choose another --out", dir));
-    NEEDLE_REQUIRE(holds_run(final_), fmt::format("--overwrite replaces only a run folder this toolkit wrote (with its {} marker, or its "
+    NEEDLE_REQUIRE(holds_run(folder), fmt::format("--overwrite replaces only a run folder this toolkit wrote (with its {} marker, or its "
                                                   "summary.json and scene.json); '{}' is not one, and is left as it is",
                                                   kMarker, dir));
   }
+  return parent;
+}
+
+}  // namespace
+
+void RunFolder::check_target(const std::string& dir, bool overwrite) { checked_parent(dir, overwrite); }
+
+RunFolder::RunFolder(const std::string& dir, bool overwrite) : final_(dir), overwrite_(overwrite) {
+  namespace fs = std::filesystem;
+  const fs::path parent = checked_parent(dir, overwrite);
+  const fs::path target = fs::weakly_canonical(fs::absolute(final_));
   partial_ = parent / ("." + target.filename().string() + ".partial");
   fs::remove_all(partial_);
   fs::create_directories(partial_);

@@ -15,6 +15,9 @@ class RunFolder {
  public:
   // InputError if DIR exists (and !overwrite) or its parent folder does not.
   RunFolder(const std::string& dir, bool overwrite);
+  // The same checks, writing nothing: a run calls it before it builds its model, so that a bad --out is
+  // refused at once, not after the setup.
+  static void check_target(const std::string& dir, bool overwrite);
   ~RunFolder();  // removes the partial folder unless commit() ran
   RunFolder(const RunFolder&) = delete;
   RunFolder& operator=(const RunFolder&) = delete;

@@ -249,6 +249,24 @@ TEST_CASE("needle run: no needle, two needles or a bad number exit 2 with one li
 }
 
 
+TEST_CASE("needle run refuses an existing output folder before it builds anything and leaves the folder as it was", "[apps][sim]") {
+  // The folder was checked only when the model had been built (2-3 s of CAD, meshing and particles); the one
+  // line of the error, without the tissue note printed after the build, shows that nothing was built first.
+  const fs::path dir = fresh_folder("run_existing");
+  fs::create_directories(dir / "mine");
+  write(dir / "mine" / "notes.txt", "keep me");
+  for (const std::string& flags : {std::string(""), std::string(" --overwrite")}) {
+    const auto r = run("run --preset SB --out " + (dir / "mine").string() + flags, true);
+    INFO(flags << " -> " << r.out);
+    CHECK(r.exit_code == 2);
+    CHECK(std::count(r.out.begin(), r.out.end(), '\n') == 1);
+    CHECK(r.out.find(flags.empty() ? "already exists" : "replaces only a run folder this toolkit wrote") != std::string::npos);
+    CHECK(r.out.find("tissue E") == std::string::npos);
+    CHECK(fs::exists(dir / "mine" / "notes.txt"));
+    CHECK_FALSE(fs::exists(dir / ".mine.partial"));
+  }
+}
+
 TEST_CASE("needle simulate --overwrite replaces only a run folder the toolkit wrote, never the current folder or one above it", "[apps][sim][gmsh][slow]") {
   // A needle-alone scene of a fraction of a second.
   const fs::path dir = fresh_folder("overwrite_guard");
