@@ -28,8 +28,12 @@ bool holds_run(const std::filesystem::path& folder) {
   return fs::is_directory(folder) && (fs::exists(folder / kMarker) || (fs::exists(folder / "summary.json") && fs::exists(folder / "scene.json")));
 }
 
-// The folder that will hold DIR, after the checks of RunFolder::check_target.
-std::filesystem::path checked_parent(const std::string& dir, bool overwrite) {
+// DIR as an absolute path and the folder that will hold it, after the checks of RunFolder::check_target.
+struct CheckedTarget {
+  std::filesystem::path target, parent;
+};
+
+CheckedTarget checked_target(const std::string& dir, bool overwrite) {
   namespace fs = std::filesystem;
   NEEDLE_REQUIRE(!dir.empty(), "--out needs a folder");
   const fs::path folder(dir);
@@ -48,18 +52,17 @@ std::filesystem::path checked_parent(const std::string& dir, bool overwrite) {
                                                   "summary.json and scene.json); '{}' is not one, and is left as it is",
                                                   kMarker, dir));
   }
-  return parent;
+  return {target, parent};
 }
 
 }  // namespace
 
-void RunFolder::check_target(const std::string& dir, bool overwrite) { checked_parent(dir, overwrite); }
+void RunFolder::check_target(const std::string& dir, bool overwrite) { checked_target(dir, overwrite); }
 
 RunFolder::RunFolder(const std::string& dir, bool overwrite) : final_(dir), overwrite_(overwrite) {
   namespace fs = std::filesystem;
-  const fs::path parent = checked_parent(dir, overwrite);
-  const fs::path target = fs::weakly_canonical(fs::absolute(final_));
-  partial_ = parent / ("." + target.filename().string() + ".partial");
+  const CheckedTarget checked = checked_target(dir, overwrite);
+  partial_ = checked.parent / ("." + checked.target.filename().string() + ".partial");
   fs::remove_all(partial_);
   fs::create_directories(partial_);
   std::ofstream(partial_ / kMarker) << "A run folder written by needle (docs/scenes.md); --overwrite may replace it.\n";
