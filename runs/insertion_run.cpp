@@ -14,6 +14,7 @@
 #include "mesher/particle_lattice.h"
 #include "mesher/vtk_files.h"
 #include "solver/insertion/groove_fill.h"
+#include "solver/insertion/strain_probes.h"
 #include "solver/insertion/coupled_insertion.h"
 #include "solver/needle/needle_models.h"
 #include "solver/separation/separation_models.h"
@@ -81,6 +82,41 @@ GrooveFill run_groove_fill(CoupledInsertion& run, const SceneNeedle& needle, con
   return measure_groove_fill(in);
 }
 
+// The tissue's minimum principal strain where the paper's model shows it (strain_probes.h), at the run's current state.
+StrainProbes run_strain_probes(CoupledInsertion& run, const SceneNeedle& needle, const Scene& scene) {
+  const TissueParticles& p = run.tissue().particles();
+  NeedleTissueContact& contact = run.contact_model();
+  StrainProbeInput in;
+  in.reference_points = contact.pull_back(p.position_mm, run.needle().positions_mm());
+  in.spacing_mm = p.spacing_mm;
+  in.min_principal_strain.resize(p.elastic_left_cauchy_green.size());
+  for (size_t i = 0; i < in.min_principal_strain.size(); ++i) in.min_principal_strain[i] = min_principal_log_strain(p.elastic_left_cauchy_green[i]);
+  const ContactSurface& surface = contact.surface();
+  in.contact_tag.assign(in.reference_points.size(), -1);
+  for (const auto& [particle, triangle] : contact.contacts())
+    if (triangle >= 0) in.contact_tag[static_cast<size_t>(particle)] = surface.triangle_tag(triangle);
+  in.tag_names = surface.tag_names();
+  in.tip_point = needle.tip_point;
+  in.groove = needle.groove;
+  in.radius_mm = needle.radius_mm;
+  const double drive_x = run.needle().drive_displacement_mm().x();
+  in.tissue_min_x_mm = scene.tissue.entry_x_mm - drive_x;
+  in.tissue_max_x_mm = scene.tissue.entry_x_mm + scene.tissue.size_mm.x() - drive_x;
+  return probe_strains(in);
+}
+
+json strain_probes_json(const StrainProbes& probes, double insertion_mm, double deflection_mm) {
+  auto region = [](const StrainRegion& r) {
+    auto number = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+    return json{{"particles", r.particles}, {"median", number(r.median)}, {"p05", number(r.p05)}, {"min", number(r.min)}};
+  };
+  return {{"insertion_mm", insertion_mm},
+          {"deflection_mm", deflection_mm},
+          {"tip_top", region(probes.tip_top)},
+          {"below_tip", region(probes.below_tip)},
+          {"groove", region(probes.groove)}};
+}
+
 class InsertionOutput {
  public:
   InsertionOutput(const RunFolder& folder, const ContactSurface& surface, const std::vector<std::unique_ptr<SeparationModel>>& separations)
@@ -140,7 +176,7 @@ class InsertionOutput {
     const TissueParticles& p = run.tissue().particles();
     const Eigen::Index np = p.size();
     Eigen::MatrixX3d x(np, 3), u(np, 3), v(np, 3);
-    Eigen::VectorXd plastic(np), effective(np), mises(np), contact(np);
+    Eigen::VectorXd plastic(np), effective(np), min_principal(np), mises(np), contact(np);
     const std::vector<std::uint8_t> in_contact = run.contact_model().in_contact();
     for (Eigen::Index i = 0; i < np; ++i) {
       const size_t s = static_cast<size_t>(i);
@@ -149,13 +185,15 @@ class InsertionOutput {
       v.row(i) = p.velocity_mm_per_ms[s].transpose();
       plastic[i] = p.plastic_strain[s];
       effective[i] = p.effective_strain[s];
+      min_principal[i] = min_principal_log_strain(p.elastic_left_cauchy_green[s]);
       const Mat3d dev = p.stress_MPa[s] - p.stress_MPa[s].trace() / 3 * Mat3d::Identity();
       mises[i] = std::sqrt(1.5 * dev.squaredNorm());
       contact[i] = in_contact[s];
     }
     const std::string tissue_name = fmt::format("frames/tissue_{:04}.vtp", index);
     write_vtp(folder_.path(tissue_name).string(), x,
-              {{"displacement_mm", u}, {"velocity_m_per_s", v}, {"plastic_strain", plastic}, {"effective_strain", effective}, {"von_mises_MPa", mises},
+              {{"displacement_mm", u}, {"velocity_m_per_s", v}, {"plastic_strain", plastic}, {"effective_strain", effective},
+               {"min_principal_strain", min_principal}, {"von_mises_MPa", mises},
                {"broken_bonds", broken_bonds(run.tissue())}, {"in_contact", contact}},
               VtkEncoding::binary);
     tissue_frames_.emplace_back(run.time_ms(), tissue_name);
@@ -277,7 +315,13 @@ class InsertionRunModel : public RunModel {
   long steps() const override { return run_->steps(); }
   void step(double end_time_ms) override { run_->step(end_time_ms); }
   void open_outputs(const RunFolder& folder) override { output_ = std::make_unique<InsertionOutput>(folder, *surface_, run_->separations()); }
-  void record() override { output_->record(*run_, tip_, run_groove_fill(*run_, built_, scene_)); }
+  void record() override {
+    output_->record(*run_, tip_, run_groove_fill(*run_, built_, scene_));
+    // The strains where the paper shows them at L = 4.8 mm: at the first record past it.
+    const double insertion_mm = needle_model_->drive_displacement_mm().norm();
+    if (early_probes_.is_null() && insertion_mm >= kEarlyProbeInsertionMm)
+      early_probes_ = strain_probes_json(run_strain_probes(*run_, built_, scene_), insertion_mm, deflection_mm());
+  }
   void frame(const RunFolder&) override { output_->frame(*run_); }
   void close_outputs(const RunFolder&) override { output_->finish(); }
   Eigen::Vector3d tip_displacement_mm() const override {
@@ -321,6 +365,12 @@ class InsertionRunModel : public RunModel {
                                         {"scaled_particles_at_end", r.scaled_particles},
                                         {"kinetic_energy_added_mJ", r.energy_mJ}};
     }
+    summary["strain_probes"] = {{"definition", "solver/insertion/strain_probes.h: the smallest principal elastic Hencky strain of the particles "
+                                               "touching the top facets (tip_top), touching the tip within 2 mm behind A and no higher than A "
+                                               "(below_tip), and inside the groove (groove); median, 5th percentile and minimum"}};
+    if (!early_probes_.is_null()) summary["strain_probes"]["early"] = early_probes_;
+    summary["strain_probes"]["end"] =
+        strain_probes_json(run_strain_probes(*run_, built_, scene_), needle_model_->drive_displacement_mm().norm(), deflection_mm());
     if (run_->cutting()) run_->cutting()->add_summary(summary);
     for (const auto& separation : run_->separations()) separation->add_summary(summary, run_->tissue());
   }
@@ -344,6 +394,10 @@ class InsertionRunModel : public RunModel {
   int tip_ = 0;
   double setup_s_ = 0;
   std::unique_ptr<InsertionOutput> output_;
+  static constexpr double kEarlyProbeInsertionMm = 4.8;  // the paper's first look (its Figs. 6 and 7)
+  json early_probes_;  // null until the insertion passes kEarlyProbeInsertionMm
+
+  double deflection_mm() const { return tip_displacement_mm().y() - drive_displacement_mm().y(); }
 };
 
 }  // namespace

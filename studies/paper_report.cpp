@@ -12,6 +12,7 @@
 #include "runs/csv_table.h"
 #include "runs/json_file.h"
 #include "runs/run_summary.h"
+#include "studies/paper_observations.h"
 #include "studies/run_model_description.h"
 #include "runs/scene.h"
 #include "studies/target_gaps.h"
@@ -38,6 +39,7 @@ struct NeedleRun : NeedleOutcome {
   std::string model_description;  // from the run's scene.json: the particles, the needle's cut, the law and the drive where not the paper's
   bool needle_cuts = false;       // the scene's tissue.contact.cuts_bonds
   CsvTable history, facets;
+  json summary;  // the run's summary.json
 };
 
 NeedleRun read_run(const std::string& out_dir, const std::string& name) {
@@ -47,6 +49,7 @@ NeedleRun read_run(const std::string& out_dir, const std::string& name) {
   const std::string summary_path = (fs::path(r.folder) / "summary.json").string();
   NEEDLE_REQUIRE(fs::exists(summary_path), fmt::format("no run of {}: '{}' is missing (run `needle paper` without --report-only first)", name, summary_path));
   const json s = read_json_file(summary_path, "run summary");
+  r.summary = s;
   const RunOutcome o = run_outcome(s);
   r.status = o.status;
   r.reason = o.reason;
@@ -296,6 +299,8 @@ void write_paper_report(const PaperReportInput& in) {
     if (!replicas.empty()) target["replicas"] = {{"checked", scatter.targets[i].checked}, {"met", scatter.targets[i].met}};
     target_list.push_back(target);
   }
+  std::vector<ObservedRun> observed;
+  for (const NeedleRun& r : runs) observed.push_back({r.name, r.summary});
   json results = {{"needles", needles},
                   {"tissue_E_MPa", in.tissue_E_MPa},
                   {"tissue_E_source", in.tissue_E_source},
@@ -306,6 +311,7 @@ void write_paper_report(const PaperReportInput& in) {
                   {"tissue", tissue},
                   {"reference", fs::proximate(in.reference_path).string()}};
   for (const ModelResults& m : replicas) results["replicas"].push_back({{"label", m.label}, {"results", m.path}});
+  if (const json observations = paper_observations_json(observed); !observations.empty()) results["observations"] = observations;
 
   // The pictures.
   save_png(deflection_plot(runs, in.reference), (dir / "deflection_vs_insertion.png").string());
@@ -392,7 +398,9 @@ void write_paper_report(const PaperReportInput& in) {
   }
   if (!replicas.empty()) md += "\n" + replica_section(scatter, replicas, targets);
   if (!models.empty()) md += "\n" + models_section(models, in.needles, in.reference);
-  md += models.empty() ? "\n## Groove filling\n\n" : "## Groove filling\n\n";
+  md += models.empty() ? "\n" : "";
+  md += paper_observations_section(observed);
+  md += "## Groove filling\n\n";
   md += "`groove_fill`: at the end of insertion, in the needle's own frame (each particle pulled back through the needle "
         "surface nearest it), the groove inside the tissue is cut into 0.05 mm slices along x; in each, the tissue's lowest "
         "edge (particle centre less half a spacing) inside the groove's section gives the filled share of the groove's depth, "

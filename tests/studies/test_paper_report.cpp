@@ -404,3 +404,51 @@ TEST_CASE("needle paper names its own runs/NAME folder even where it is a link t
   CHECK(read_json(dir / "results.json")["needles"]["SB"]["run_folder"] == "runs/SB");
   CHECK(read_text(dir / "report.md").find("| SB | `runs/SB` |") != std::string::npos);
 }
+
+TEST_CASE("needle paper sets the paper's other observations beside the runs' strain probes, and leaves the table out for runs without them",
+          "[apps][paper][slow]") {
+  const fs::path dir = fresh("observations");
+  const std::map<std::string, FakeRun> runs = {{"SB", {-1.10, 0.90}}, {"LMB", {0.12, 0.95}}, {"AMB", {0.20, 0.40}}, {"HMB", {1.20, 0.10}}};
+  for (const auto& [name, r] : runs) write_run(dir, name, r);
+  SECTION("without probes: no table") {
+    const auto result = run("paper --report-only --no-tips --quiet --out " + dir.string(), true);
+    REQUIRE(result.exit_code == 0);
+    CHECK(read_text(dir / "report.md").find("## The paper's other observations") == std::string::npos);
+    CHECK_FALSE(read_json(dir / "results.json").contains("observations"));
+  }
+  SECTION("with probes: each observation beside ours, an empty region said so") {
+    // Each needle's probes: distinct numbers, so that a value in the wrong row would show.
+    const std::map<std::string, double> offset = {{"SB", 0.0}, {"LMB", 0.01}, {"AMB", 0.02}, {"HMB", 0.03}};
+    for (const auto& [name, d] : offset) {
+      const fs::path path = dir / "runs" / name / "summary.json";
+      json summary = read_json(path);
+      auto region = [](int particles, double p05, double median) {
+        return json{{"particles", particles}, {"p05", p05}, {"median", median}, {"min", p05 - 0.1}};
+      };
+      summary["strain_probes"] = {
+          {"early", {{"insertion_mm", 4.83}, {"deflection_mm", -0.004 - d}, {"tip_top", region(12, -1.25 - d, -0.7)},
+                     {"below_tip", region(9, -0.51 - d, -0.3)}, {"groove", region(0, 0, 0)}}},
+          {"end", {{"insertion_mm", 30.0}, {"deflection_mm", -1.1}, {"tip_top", region(30, -1.71 - d, -0.9)},
+                   {"below_tip", region(20, -0.88 - d, -0.5)}, {"groove", region(40, -0.55 - d, -0.2)}}}};
+      std::ofstream(path) << summary.dump(2);
+    }
+    const auto result = run("paper --report-only --no-tips --quiet --out " + dir.string(), true);
+    INFO(result.out);
+    REQUIRE(result.exit_code == 0);
+    const std::string md = read_text(dir / "report.md");
+    INFO(md);
+    CHECK(md.find("## The paper's other observations") != std::string::npos);
+    CHECK(md.find("| SB | min. principal strain on the top facets, L 4.8 mm | about -1.2 | -1.25 (median -0.70; 12 particles) |") != std::string::npos);
+    CHECK(md.find("| SB | min. principal strain on the top facets, L 30 mm | about -1.8 | -1.71 (median -0.90; 30 particles) |") != std::string::npos);
+    CHECK(md.find("| LMB | min. principal strain below the tip, L 4.8 mm | about -0.45 | -0.52 (median -0.30; 9 particles) |") != std::string::npos);
+    CHECK(md.find("| AMB | min. principal strain below the tip, L 30 mm | about -0.9 | -0.90 (median -0.50; 20 particles) |") != std::string::npos);
+    CHECK(md.find("| HMB | min. principal strain below the tip, L 30 mm | about -1.20 | -0.91 (median -0.50; 20 particles) |") != std::string::npos);
+    CHECK(md.find("| AMB | min. principal strain in the groove, L 30 mm | about 0 (rebounded) | -0.57 (median -0.20; 40 particles) |") != std::string::npos);
+    CHECK(md.find("| LMB | deflection, L 4.8 mm | 0 | -0.014 mm at 4.8 mm |") != std::string::npos);
+    // The fake runs' floor contact is half their groove fill, their mean gap 0.1 mm.
+    CHECK(md.find("| HMB | tissue on the groove floor, L 30 mm | none, a gap | floor contact 0.05, mean gap 0.100 mm |") != std::string::npos);
+    const json results = read_json(dir / "results.json");
+    REQUIRE(results.contains("observations"));
+    CHECK(results["observations"].size() == 17);
+  }
+}
