@@ -4,6 +4,9 @@
 # --checking also installs what the checking build needs (scripts/test-sanitizers.sh): clang with its sanitizer
 # and libFuzzer runtimes.
 # Safe to run again: apt-get skips what is already there.
+# --no-install-recommends matters: python3-openturns recommends ATLAS, whose libblas.so.3 would take over Debian's BLAS
+# alternative from the reference BLAS and move the implicit needle's results in their last digits (CHOLMOD calls it;
+# ../shared/DEPENDENCIES.md). The end of this script checks the alternative and says so if another BLAS holds it.
 set -euo pipefail
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
@@ -20,17 +23,29 @@ PACKAGES=(
   libsuitesparse-dev libspectra-dev
   libnlopt-dev libnlopt-cxx-dev libopenmpi-dev openmpi-bin
   python3-meshio
+  python3-openturns python3-matplotlib
   python3-paraview xvfb xauth
 )
 if [ "${1:-}" = "--checking" ]; then PACKAGES+=(clang libclang-rt-14-dev); fi
+# Which BLAS Debian's alternative selects: a note when it is not the reference one.
+check_blas() {
+  local selected
+  selected="$(readlink -f /usr/lib/x86_64-linux-gnu/libblas.so.3 2>/dev/null || true)"
+  case "$selected" in
+    */blas/libblas.so.3*|"") ;;
+    *) echo "install-deps: note: libblas.so.3 is $selected, not the reference BLAS; the implicit needle's results may differ from the stored ones in their last digits (update-alternatives --config libblas.so.3-x86_64-linux-gnu)" ;;
+  esac
+}
 missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
 if [ "${#missing[@]}" -eq 0 ]; then
   echo "install-deps: all ${#PACKAGES[@]} packages already installed"
+  check_blas
   exit 0
 fi
 echo "install-deps: installing ${missing[*]}"
 $SUDO apt-get update -qq
 DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+check_blas

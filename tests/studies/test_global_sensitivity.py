@@ -1,0 +1,140 @@
+#!/usr/bin/python3
+"""Tests of studies/sensitivity/global_sensitivity.py (the global sensitivity study of the paper's unknowns).
+
+- The design: ranges map linearly, levels take equal shares of [0, 1); batch k+1 extends batches 0..k; every needle
+  of a point gets the same values; the sweep file of a batch is accepted by `needle sweep --count` (the scene reader
+  checks every key and value) and counts points x needles cases.
+- The statistics, on a study whose "runs" are a known function written as case records: the HSIC screen finds the
+  two factors the ratios depend on (p < 0.01) and gives the inert ones a far smaller index, and the kriging surrogate
+  of a smooth ratio predicts left-out points (Q2 > 0.9) and reaches the function's own extremes over the box.
+- Bad study files are refused with one line and exit 2.
+Usage: test_global_sensitivity.py NEEDLE_BINARY SOURCE_DIR. Exit 77 (skipped) without python3-openturns.
+"""
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+needle, source = sys.argv[1], sys.argv[2]
+try:
+    import openturns  # noqa: F401
+except ImportError:
+    print("skipped: python3-openturns is not installed")
+    sys.exit(77)
+sys.path.insert(0, os.path.join(source, "studies", "sensitivity"))
+import global_sensitivity as gs  # noqa: E402
+
+failures = []
+
+
+def check(condition, what):
+    print(("ok   " if condition else "FAIL ") + what)
+    if not condition:
+        failures.append(what)
+
+
+study = gs.read_study(os.path.join(source, "data", "studies", "global_sensitivity.json"))
+
+# The design.
+check(gs.factor_value({"range": [2.0, 4.0]}, 0.25) == 2.5, "a range maps u linearly")
+check([gs.factor_value({"levels": ["a", "b", "c"]}, u) for u in (0.0, 0.34, 0.67, 0.999)] == ["a", "b", "c", "c"],
+      "levels take equal shares of [0, 1)")
+n = study["batch_points"]
+first_two = gs.unit_design(len(study["factors"]), 2 * n)
+check(gs.unit_design(len(study["factors"]), n) == first_two[:n], "batch 1 extends batch 0 without moving it")
+check(all(0.0 <= v < 1.0 for row in first_two for v in row), "the unit design lies in [0, 1)")
+cases = gs.batch_cases(study, 1)
+check(len(cases) == n * len(study["needles"]) and cases[0][0] == n, "batch 1 holds points n..2n-1 on every needle")
+by_point = {}
+for point, needle_name, values in cases:
+    by_point.setdefault(point, []).append(values)
+check(all(all(v == vs[0] for v in vs) for vs in by_point.values()), "every needle of a point gets the same values")
+for f in study["factors"]:
+    for point, _, values in cases:
+        v = values[f["key"]]
+        inside = (f["range"][0] <= v <= f["range"][1]) if "range" in f else (v in f["levels"])
+        if not inside:
+            check(False, f"{f['name']} = {v} lies in its range")
+            break
+
+with tempfile.TemporaryDirectory() as tmp:
+    path = gs.write_batch(study, tmp, 0)
+    count = subprocess.run([needle, "sweep", path, "--count"], capture_output=True, text=True)
+    check(count.returncode == 0 and count.stdout.strip() == str(n * len(study["needles"])),
+          f"needle sweep --count accepts batch 0's sweep file ({count.stdout.strip()} cases{', ' + count.stderr.strip() if count.stderr else ''})")
+    check(gs.write_batch(study, tmp, 0) == path, "writing the same batch again is accepted")
+
+# The statistics on a known function. Ratios depend on two factors only (friction and groove_start_mm), smoothly;
+# the deflections scale with E. Every other factor is inert.
+def truth(values):
+    fr = (values["tissue.friction"] - 0.05) / 0.35
+    gsm = (values["needle.groove_start_mm"] - 3.0) / 3.0
+    e = values["tissue.material.E_MPa"]
+    sb = -1.14 * e / 0.0884
+    ratio = {"LMB": -0.5 + 0.6 * gsm, "AMB": -1.3 + 0.8 * gsm + 0.5 * fr * fr, "HMB": -2.2 + 0.4 * fr}
+    out = {"SB": sb}
+    out.update({k: v * sb for k, v in ratio.items()})
+    return out, ratio
+
+
+with tempfile.TemporaryDirectory() as tmp:
+    small = dict(study)
+    small["batch_points"] = 32
+    gs.write_batch(small, tmp, 0)
+    for index, (point, needle_name, values) in enumerate(gs.batch_cases(small, 0)):
+        case_dir = os.path.join(tmp, "batch_0", "sweep", "cases", f"case_{index:04d}")
+        os.makedirs(case_dir)
+        deflection, _ = truth(values)
+        record = {"label": f"point {point:03d} {needle_name}", "status": "finished", "deflection_mm": deflection[needle_name],
+                  "groove_fill": 0.9, "runtime_s": 1.0}
+        # One point's HMB stops: the point must be left out and reported incomplete.
+        if point == 5 and needle_name == "HMB":
+            record = {"label": record["label"], "status": "stopped", "reason": "energy drift", "deflection_mm": None}
+        with open(os.path.join(case_dir, "case.json"), "w") as f:
+            json.dump(record, f)
+    result = gs.analyze(small, tmp, permutations=400)
+    check(result["points_complete"] == 31 and result["points_incomplete"][0]["point"] == 5,
+          "a point with a stopped needle is left out and listed as incomplete")
+    hsic = result["hsic"]
+    for response, drivers in (("ratio_LMB", ["groove_start_mm"]), ("ratio_AMB", ["groove_start_mm", "friction"]), ("ratio_HMB", ["friction"]),
+                              ("delta_SB_mm", ["E_MPa"])):
+        top = max(hsic[response].items(), key=lambda kv: kv[1]["r2_hsic"])
+        check(top[0] in drivers and top[1]["p_value"] < 0.01, f"{response}: the top factor is a driver ({top[0]}, p {top[1]['p_value']:.3f})")
+        inert = [v["r2_hsic"] for k, v in hsic[response].items() if k not in drivers and k != "E_MPa"]
+        check(max(inert) < 0.3 * top[1]["r2_hsic"], f"{response}: every inert factor's index is below 0.3 of the driver's ({max(inert):.3f})")
+    amb = next(s for s in result["surrogates"] if s["response"] == "ratio_AMB")
+    check(set(["groove_start_mm", "friction"]) <= set(amb["factors"]), f"the AMB surrogate takes its two drivers ({amb['factors']})")
+    check(amb["leave_one_out_q2"] > 0.9, f"the AMB surrogate predicts left-out points (Q2 {amb['leave_one_out_q2']:.3f})")
+    check(abs(amb["box_min"]["value"] - (-1.3)) < 0.05 and abs(amb["box_max"]["value"] - (-1.3 + 0.8 + 0.5)) < 0.05,
+          f"the AMB surrogate reaches the function's extremes over the box ({amb['box_min']['value']:.3f}, {amb['box_max']['value']:.3f})")
+    # The joint search's best point against the function's own minimax, by brute force over its two drivers.
+    best = float("inf")
+    for i in range(201):
+        for j in range(201):
+            fr, gsm = i / 200, j / 200
+            values = {"tissue.friction": 0.05 + 0.35 * fr, "needle.groove_start_mm": 3.0 + 3.0 * gsm, "tissue.material.E_MPa": 0.0884}
+            _, ratio = truth(values)
+            best = min(best, max(abs(-1.14 * ratio[k] - gs.MEASURED_MM[k]) for k in ratio))
+    joint = result["joint"]
+    check(abs(joint["best_max_error_mm"] - best) < 0.03,
+          f"the joint search finds the function's smallest largest error over the box ({joint['best_max_error_mm']:.3f} against {best:.3f} mm)")
+    for name in ("points.csv", "hsic.csv", "hsic.md", "surrogate.json", "hsic.png", "ratio_scatter.png"):
+        check(os.path.getsize(os.path.join(tmp, "analysis", name)) > 0, f"analysis/{name} is written")
+
+# Bad study files.
+with tempfile.TemporaryDirectory() as tmp:
+    bad = os.path.join(tmp, "bad.json")
+    with open(bad, "w") as f:
+        json.dump({"needles": ["LMB"], "factors": [], "batch_points": 4}, f)
+    script = os.path.join(source, "studies", "sensitivity", "global_sensitivity.py")
+    r = subprocess.run([sys.executable, script, "--study", bad, "--out", os.path.join(tmp, "o"), "--design-only"], capture_output=True, text=True)
+    check(r.returncode == 2 and r.stderr.count("\n") == 1 and "SB" in r.stderr and not os.path.exists(os.path.join(tmp, "o")),
+          f"a study without SB is refused with one line, exit 2, nothing written ({r.stderr.strip()})")
+    with open(bad, "w") as f:
+        json.dump({"needles": ["SB"], "factors": [{"name": "a", "key": "tissue.friction", "range": [0.3, 0.1]}], "batch_points": 4}, f)
+    r = subprocess.run([sys.executable, script, "--study", bad, "--out", os.path.join(tmp, "o"), "--design-only"], capture_output=True, text=True)
+    check(r.returncode == 2 and "lo < hi" in r.stderr, f"an empty range is refused ({r.stderr.strip()})")
+
+print(f"{len(failures)} failed" if failures else "all passed")
+sys.exit(1 if failures else 0)
