@@ -7,6 +7,8 @@
 - The statistics, on a study whose "runs" are a known function written as case records: the HSIC screen finds the
   two factors the ratios depend on (p < 0.01) and gives the inert ones a far smaller index, and the kriging surrogate
   of a smooth ratio predicts left-out points (Q2 > 0.9) and reaches the function's own extremes over the box.
+- One more parameter fitted honestly (second_parameter.py): on ratios linear in the value, each fit and each held-out
+  prediction has a closed form; its sweep file passes `needle sweep --count`.
 - Bad study files are refused with one line and exit 2.
 Usage: test_global_sensitivity.py NEEDLE_BINARY SOURCE_DIR. Exit 77 (skipped) without python3-openturns.
 """
@@ -121,6 +123,33 @@ with tempfile.TemporaryDirectory() as tmp:
           f"the joint search finds the function's smallest largest error over the box ({joint['best_max_error_mm']:.3f} against {best:.3f} mm)")
     for name in ("points.csv", "hsic.csv", "hsic.md", "surrogate.json", "hsic.png", "ratio_scatter.png"):
         check(os.path.getsize(os.path.join(tmp, "analysis", name)) > 0, f"analysis/{name} is written")
+
+# One more parameter fitted honestly (second_parameter.py): ratios linear in the value, so every fit has a closed form.
+import second_parameter as sp  # noqa: E402
+
+def linear_ratios(amb_offset):
+    out = {}
+    for v in (3.0, 4.0, 5.0, 6.0):
+        out[v] = {"LMB": 0.15 / -1.14 + 0.2 * (v - 5),
+                  "AMB": 0.24 / -1.14 + amb_offset + 0.3 * (v - 5), "HMB": 1.71 / -1.14 + 0.1 * (v - 5), "delta_SB_mm": -1.14}
+    return out
+
+exact = sp.analyse("needle.groove_start_mm", linear_ratios(0.0))
+check(all(abs(h["value"] - 5.0) < 0.01 and abs(h["error_mm"]) < 0.01 for h in exact["leave_one_out"]),
+      "second parameter: where one value fits every needle, each held-out needle is predicted at that value with no error")
+shifted = sp.analyse("needle.groove_start_mm", linear_ratios(-0.2))
+amb_only = next(s_ for s_ in shifted["fitted_on_one"] if s_["fitted_on"] == "AMB")
+check(abs(amb_only["value"] - (5.0 + 0.2 / 0.3)) < 0.01 and abs(amb_only["errors_mm"]["AMB"]) < 0.005,
+      f"second parameter: fitted on AMB alone, the value solves AMB's ratio ({amb_only['value']:.4f} against {5.0 + 0.2 / 0.3:.4f})")
+held_amb = next(h for h in shifted["leave_one_out"] if h["held_out"] == "AMB")
+check(abs(held_amb["value"] - 5.0) < 0.01 and abs(held_amb["error_mm"] - (-1.14 * -0.2)) < 0.01,
+      f"second parameter: AMB held out is predicted from the value LMB and HMB fit, its error the offset's ({held_amb['error_mm']:+.3f} mm)")
+with tempfile.TemporaryDirectory() as tmp:
+    path = os.path.join(tmp, "sweep.json")
+    with open(path, "w") as f:
+        json.dump(sp.sweep_file("needle.groove_start_mm", [3.0, 5.0], 30.0), f)
+    count = subprocess.run([needle, "sweep", path, "--count"], capture_output=True, text=True)
+    check(count.returncode == 0 and count.stdout.strip() == "8", f"second parameter: its sweep file passes needle sweep --count ({count.stdout.strip()})")
 
 # Bad study files.
 with tempfile.TemporaryDirectory() as tmp:
