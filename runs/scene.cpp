@@ -8,6 +8,7 @@
 #include "runs/material_json.h"
 #include "runs/scene_object.h"
 #include "core/input_error.h"
+#include "core/units.h"
 #include "solver/needle/needle_models.h"
 
 namespace needle {
@@ -304,6 +305,20 @@ json scene_to_json(const Scene& s) {
 
 namespace needle {
 
+namespace {
+
+// A key without its unit suffix: the quantity it names. "travel_mm" and "travel" name one quantity (a setting of one
+// replaces the other); "stabilization" and "stabilization_coefficient" name two.
+std::string quantity_of_key(const std::string& key) {
+  for (Dimension d : {Dimension::length, Dimension::time, Dimension::speed, Dimension::stress, Dimension::density, Dimension::angle}) {
+    const std::string suffix = canonical_suffix(d);
+    if (key.size() > suffix.size() && key.compare(key.size() - suffix.size(), suffix.size(), suffix) == 0) return key.substr(0, key.size() - suffix.size());
+  }
+  return key;
+}
+
+}  // namespace
+
 Scene apply_scene_settings(const Scene& scene, const std::vector<std::string>& settings, const std::string& source) {
   if (settings.empty()) return scene;
   // How a setting is named in messages: "--set key=value", or the setting alone.
@@ -335,7 +350,8 @@ Scene apply_scene_settings(const Scene& scene, const std::vector<std::string>& s
     const bool is_source = path.size() == 2 && path[0] == "needle" && std::find(sources.begin(), sources.end(), leaf) != sources.end();
     for (auto it = section->begin(); it != section->end();) {
       const std::string& other = it.key();
-      const bool same_key = other == leaf || other.rfind(leaf + "_", 0) == 0 || leaf.rfind(other + "_", 0) == 0;
+      // The same quantity in another unit spelling only: a longer key that merely begins with this one stays.
+      const bool same_key = quantity_of_key(other) == quantity_of_key(leaf);
       const bool other_source = is_source && std::find(sources.begin(), sources.end(), other) != sources.end();
       it = (same_key || other_source) && !it.value().is_object() ? section->erase(it) : std::next(it);
     }

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "runs/scene.h"
@@ -53,6 +55,45 @@ TEST_CASE("apply_scene_settings sets dotted keys with units, replaces a key's ot
   CHECK(refusal("tissue.material.E_MPa") == "--set tissue.material.E_MPa: give key=value, e.g. --set tissue.material.E_MPa=0.1");
   CHECK(refusal("tissue..nu=1").find("is not a dotted scene key") != std::string::npos);
   CHECK(refusal("needle.length_mm.x=1").find("length_mm is a value, not a section") != std::string::npos);
+}
+
+TEST_CASE("--set touches only its own key and that key's unit spellings: every key next to a longer key of the same prefix keeps its neighbour",
+          "[apps][scene]") {
+  // Every optional key written, so that every pair of keys the effective scene can hold is here.
+  const needle::Scene base = needle::parse_scene(
+      R"({"tissue": {"enabled": true, "spg": {"stabilization_coefficient": 0.3, "kernel_update_interval_steps": 25},
+                     "material": {"relaxing_shear_fraction": 0.5, "relaxation_time_ms": 0.2},
+                     "contact": {"slit_half_height_mm": 0.5, "crack_reach_mm": 1, "cutting_pressure_MPa": 0.1}},
+          "solver": {"tissue_mass_scaling": true, "tissue_mass_scaling_dt_ms": 0.003}})",
+      "(test)");
+  // The longer key's value above, which a default would not give back.
+  const std::map<std::string, nlohmann::json> neighbour_value = {
+      {"stabilization_coefficient", 0.3}, {"kernel_update_interval_steps", 25}, {"tissue_mass_scaling_dt_ms", 0.003}};
+  int pairs = 0;
+  std::function<void(const nlohmann::json&, const std::string&)> walk = [&](const nlohmann::json& section, const std::string& path) {
+    for (const auto& [key, value] : section.items()) {
+      if (value.is_object()) {
+        walk(value, path + key + ".");
+        continue;
+      }
+      for (const auto& [longer, longer_value] : section.items()) {
+        if (longer_value.is_object() || longer.rfind(key + "_", 0) != 0) continue;
+        // `key` and `longer` are two settings (no unit suffix turns one into the other, e.g. stabilization and
+        // stabilization_coefficient): setting the first to its own value must leave the second as it was.
+        INFO(path + key + " next to " + path + longer);
+        REQUIRE(neighbour_value.count(longer));  // a new pair: give the longer key a value other than its default above
+        ++pairs;
+        const needle::Scene set = needle::apply_scene_settings(base, {path + key + "=" + (value.is_string() ? value.get<std::string>() : value.dump())});
+        // Set to its own value, the key changes nothing: an erased neighbour would fall back to its default.
+        CHECK(needle::scene_to_json(set) == needle::scene_to_json(base));
+      }
+    }
+  };
+  walk(needle::scene_to_json(base), "");
+  CHECK(pairs == 3);
+  // A unit spelling still replaces the other: travel after travel_mm, E after E_MPa.
+  const needle::Scene travel = needle::apply_scene_settings(base, {"motion.travel=2 cm"});
+  CHECK(travel.motion.travel_mm == Approx(20.0).epsilon(1e-12));
 }
 
 TEST_CASE("needle run --set and needle simulate --set change the run's scene; a bad key is refused with nothing written", "[apps][lspg][gmsh]") {
