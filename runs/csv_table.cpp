@@ -41,7 +41,7 @@ std::vector<double> CsvTable::column(const std::string& name) const {
 }
 
 CsvTable read_csv_table(const std::string& path) {
-  refuse_folder_as_file(path, "table");
+  check_input_file(path, "table");
   std::ifstream in(path);
   NEEDLE_REQUIRE(in.good(), fmt::format("cannot read '{}'", path));
   CsvTable table;

@@ -12,7 +12,7 @@
 namespace needle {
 
 nlohmann::json read_json_file(const std::string& path, const std::string& what) {
-  refuse_folder_as_file(path, what);
+  check_input_file(path, what);
   std::ifstream in(path);
   NEEDLE_REQUIRE(in.good(), fmt::format("cannot read the {} '{}'", what, path));
   try {

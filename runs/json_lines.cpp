@@ -143,7 +143,7 @@ JsonDocument parse_json_with_lines(const std::string& text, const std::string& s
 }
 
 JsonDocument read_json_with_lines(const std::string& path) {
-  refuse_folder_as_file(path, "JSON file");
+  check_input_file(path, "JSON file");
   std::ifstream in(path, std::ios::binary);
   NEEDLE_REQUIRE(in, fmt::format("cannot read '{}'", path));
   std::stringstream text;

@@ -28,7 +28,7 @@ TissueMaterial material_from_json(const nlohmann::json& json, const std::string&
 }
 
 TissueMaterial read_material_file(const std::string& path) {
-  refuse_folder_as_file(path, "material file");
+  check_input_file(path, "material file");
   std::ifstream in(path);
   NEEDLE_REQUIRE(in, fmt::format("cannot read material file '{}'", path));
   nlohmann::json json;

@@ -87,7 +87,7 @@ GrindingRecipe recipe_from_json(const json& root, const std::string& source) {
 }
 
 GrindingRecipe read_recipe_file(const std::string& path) {
-  refuse_folder_as_file(path, "recipe");
+  check_input_file(path, "recipe");
   std::ifstream in(path);
   NEEDLE_REQUIRE(in.good(), fmt::format("cannot read recipe '{}': no such file", path));
   json root;

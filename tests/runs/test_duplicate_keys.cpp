@@ -5,8 +5,10 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <sys/stat.h>
 
 #include "core/input_error.h"
+#include "core/input_file.h"
 #include "runs/json_file.h"
 #include "runs/material_json.h"
 #include "runs/recipe_json.h"
@@ -67,6 +69,29 @@ TEST_CASE("A folder named as a scene, a card or a result file is refused in the 
   CHECK(refusal([&] { needle::read_json_file(folder.string(), "summary"); }) ==
         "cannot read the summary '" + folder.string() + "': it is a folder, not a file");
   std::filesystem::remove_all(folder);
+}
+
+TEST_CASE("A device, a pipe or an oversized file named as a scene, a recipe, a card or a table is refused at once, before it is read",
+          "[apps][scene]") {
+  // /dev/zero was read until memory ran out; a pipe with no writer would block for ever.
+  CHECK(refusal([] { needle::read_scene("/dev/zero"); }) == "cannot read the JSON file '/dev/zero': it is not a regular file (a device, pipe or socket)");
+  CHECK(refusal([] { needle::read_recipe_file("/dev/zero"); }).find("it is not a regular file") != std::string::npos);
+  CHECK(refusal([] { needle::read_material_file("/dev/zero"); }).find("it is not a regular file") != std::string::npos);
+  CHECK(refusal([] { needle::read_json_file("/dev/zero", "summary"); }).find("it is not a regular file") != std::string::npos);
+  const std::filesystem::path fifo = std::filesystem::temp_directory_path() / "needle_fifo_not_file.json";
+  std::filesystem::remove(fifo);
+  REQUIRE(mkfifo(fifo.c_str(), 0600) == 0);
+  CHECK(refusal([&] { needle::read_scene(fifo.string()); }).find("it is not a regular file") != std::string::npos);
+  std::filesystem::remove(fifo);
+  // A sparse file past the limit: refused by its size, not read.
+  const std::filesystem::path big = std::filesystem::temp_directory_path() / "needle_big_scene.json";
+  { std::ofstream(big) << "{}"; }
+  std::filesystem::resize_file(big, needle::kMaxInputFileBytes + 1);
+  CHECK(refusal([&] { needle::read_scene(big.string()); }) ==
+        "cannot read the JSON file '" + big.string() + "': it holds 67108865 bytes, more than the 64 MiB such a file may hold");
+  std::filesystem::resize_file(big, 2);  // at the limit or below, read as before
+  CHECK(refusal([&] { needle::read_scene(big.string()); }) == "accepted");
+  std::filesystem::remove(big);
 }
 
 TEST_CASE("A JSON error reads in the project's words, without the parser's exception tag", "[apps][scene]") {
