@@ -9,6 +9,7 @@
 #include "apps/cli_checks.h"
 #include "core/input_error.h"
 #include "core/parallel.h"
+#include "core/solver_error.h"
 #include "sweeps/sweep_executor.h"
 #include "sweeps/sweep_mpi.h"
 #include "sweeps/sweep_plan.h"
@@ -37,10 +38,18 @@ void print_table_summary(const fs::path& dir, const SweepPlan& plan, const std::
   fmt::print("sweep: table {} and {}\n", (dir / "sweep.csv").string(), (dir / "sweep.json").string());
 }
 
+// Writes the table, then says whether every case finished: StudyIncomplete (exit 3) when some stopped, timed out,
+// failed or were not run. A tip that cannot be ground (infeasible) is the design's answer, not a case that failed.
 void write_and_print_table(const fs::path& dir, const SweepPlan& plan) {
   const std::vector<CaseResult> rows = collect_case_records(dir, plan.cases);
   write_sweep_table(dir, plan, rows, std::string(NEEDLE_DATA_DIR) + "/paper/reference.json");
   print_table_summary(dir, plan, rows);
+  const SweepCounts c = count_cases(rows);
+  const int unfinished = c.stopped + c.timed_out + c.failed + c.pending;
+  if (unfinished > 0)
+    throw StudyIncomplete(fmt::format("{} of {} cases did not finish ({} stopped, {} timed out, {} failed, {} not run): the table holds the others; "
+                                      "exit 3",
+                                      unfinished, rows.size(), c.stopped, c.timed_out, c.failed, c.pending));
 }
 
 void run(const SweepOptions& o) {
@@ -120,6 +129,8 @@ void add_sweep_command(CLI::App& app) {
   c->add_flag("--collect", o->collect, "Build the table from the cases done in --out (after a batch array)");
   c->add_flag("--count", o->count, "Print the number of cases and exit (for sbatch --array=0-(N-1))");
   c->add_flag("--quiet", o->quiet, "No progress lines");
+  c->footer("Exit codes: 0 every case finished (or its tip cannot be ground); 3 the table is written but some cases stopped, timed out, "
+            "failed or were not run; 2 bad input; 130 interrupted (the finished cases stay).");
   c->callback([o] { run(*o); });
 }
 

@@ -10,3 +10,13 @@ struct SolverError : std::runtime_error {
 };
 
 }  // namespace needle
+
+namespace needle {
+
+// A study (a sweep) whose table is written but whose cases did not all finish: some stopped, timed out, failed or
+// were not run. The command exits 3, as a run the solver stopped does, so that a script can tell.
+struct StudyIncomplete : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+}  // namespace needle

@@ -189,6 +189,24 @@ TEST_CASE("needle sweep gives one table on worker processes, on MPI ranks and as
   const Result missing = run("sweep " + sweep + " --out " + (dir / "nothing").string() + " --collect", true);
   CHECK(missing.exit_code == 2);
   CHECK(!fs::exists(dir / "nothing"));
+
+  // A table whose cases did not all finish is still written, and the sweep exits 3 saying how many did not: here one
+  // finished case's record turned into a stopped one (the two infeasible tips are the design's answer, not failures).
+  const json table_before = read_json(dir / "array" / "sweep.json");
+  for (const json& c : table_before["cases"]) {
+    if (c["status"] != "finished") continue;
+    const fs::path record = dir / "array" / "cases" / c["name"].get<std::string>() / "case.json";
+    json r = read_json(record);
+    r["status"] = "stopped";
+    r["reason"] = "energy drift (a test's edit)";
+    std::ofstream(record) << r.dump(2);
+    break;
+  }
+  const Result incomplete = run("sweep " + sweep + " --out " + (dir / "array").string() + " --collect", true);
+  INFO(incomplete.out);
+  CHECK(incomplete.exit_code == 3);
+  CHECK(incomplete.out.find("needle: 1 of 6 cases did not finish (1 stopped, 0 timed out, 0 failed, 0 not run)") != std::string::npos);
+  CHECK(read_json(dir / "array" / "sweep.json")["counts"]["stopped"] == 1);
 }
 
 TEST_CASE("A sweep interrupted midway loses no finished case and repeats none when started again", "[sweeps][gmsh][lspg][slow]") {
