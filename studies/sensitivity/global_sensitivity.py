@@ -286,6 +286,67 @@ def fit_kriging(study, rows, response, factor_names):
     return fit(x, y), factors, q2, math.sqrt(press)
 
 
+def pce_sobol(study, rows, response, degree=2):
+    """A sparse additive polynomial chaos of the response over every factor (Legendre polynomials of each factor scaled to
+    [0, 1] up to `degree`, no interaction terms, the terms chosen by LARS with corrected leave-one-out), its leave-one-out Q2 (refitted without
+    each point), and the first-order and total Sobol' indices it gives: {factor: (first, total)}."""
+    import openturns as ot
+    ot.Log.Show(ot.Log.NONE)
+    factors = study["factors"]
+    dim = len(factors)
+    x = ot.Sample([[unit_coordinate(f, r[f["name"]]) for f in factors] for r in rows])
+    y = ot.Sample([[r[response]] for r in rows])
+    # A range is uniform on [0, 1] (Legendre polynomials); a factor of L levels takes each of its L points with equal
+    # weight (its own orthogonal polynomials), and no polynomial of degree L or more, which its points cannot tell from
+    # the lower ones: the enumeration's weight L - 1 ... is 2 for two levels, so a degree-2 chaos gives it degree 1.
+    marginals, families, weights = [], [], []
+    for f in factors:
+        if "range" in f:
+            marginals.append(ot.Uniform(0.0, 1.0))
+            families.append(ot.LegendreFactory())
+            weights.append(1.0)
+        else:
+            count = len(f["levels"])
+            points = ot.UserDefined([[k / (count - 1)] for k in range(count)])
+            marginals.append(points)
+            families.append(ot.StandardDistributionPolynomialFactory(ot.AdaptiveStieltjesAlgorithm(points)))
+            weights.append(degree / (count - 1) if count - 1 < degree else 1.0)
+    distribution = ot.ComposedDistribution(marginals)
+    # Hyperbolic truncation (q = 0.5): each factor's own polynomials up to the degree, no products of two factors. With a
+    # few dozen points in sixteen dimensions the products alias the main effects, and LARS would pick aliases.
+    basis = ot.OrthogonalProductPolynomialFactory(families, ot.HyperbolicAnisotropicEnumerateFunction(weights, 0.5))
+    size = basis.getEnumerateFunction().getStrataCumulatedCardinal(degree)
+
+    def fit(xs, ys):
+        algo = ot.FunctionalChaosAlgorithm(xs, ys, distribution, ot.FixedStrategy(basis, size),
+                                           ot.LeastSquaresStrategy(ot.LeastSquaresMetaModelSelectionFactory(ot.LARS(), ot.CorrectedLeaveOneOut())))
+        algo.run()
+        return algo.getResult()
+
+    n = x.getSize()
+    errors = []
+    for k in range(n):
+        keep = [i for i in range(n) if i != k]
+        errors.append(fit(x[keep], y[keep]).getMetaModel()(x[k])[0] - y[k][0])
+    mean = y.computeMean()[0]
+    variance = sum((y[i][0] - mean) ** 2 for i in range(n)) / n
+    q2 = 1.0 - sum(e * e for e in errors) / n / variance if variance > 0 else float("nan")
+    result = fit(x, y)
+    sobol = ot.FunctionalChaosSobolIndices(result)
+    indices = {f["name"]: (float(sobol.getSobolIndex(j)), float(sobol.getSobolTotalIndex(j))) for j, f in enumerate(factors)}
+    return {"response": response, "degree": degree, "terms": int(result.getIndices().getSize()), "leave_one_out_q2": q2, "sobol": indices}
+
+
+def chaos_or_none(study, rows, response):
+    """The chaos of degree 2, else of degree 1 where too few points make the least squares singular; None if neither."""
+    for degree in (2, 1):
+        try:
+            return pce_sobol(study, rows, response, degree)
+        except (TypeError, RuntimeError):  # OpenTURNS' InvalidArgumentException: a singular least-squares system
+            continue
+    return None
+
+
 def box_grid(factors, size=4096):
     """Points over the factors' box in unit coordinates: ranges over their whole span, levels at the levels only."""
     import openturns as ot
@@ -423,6 +484,8 @@ def analyze(study, out, permutations=2000, top=3):
     for r in [x for x in resp if x.startswith("ratio_")]:
         names = [n for n, _ in sorted(table[r].items(), key=lambda kv: -kv[1][0])[:top]]
         surrogates.append(kriging_surrogate(study, rows, r, names))
+    chaos = [chaos_or_none(study, rows, r) for r in resp if r.startswith("ratio_")]
+    chaos = [c for c in chaos if c]
     joint_factors = []
     for s_ in surrogates:
         joint_factors += [n for n in s_["factors"] if n not in joint_factors]
@@ -430,7 +493,7 @@ def analyze(study, out, permutations=2000, top=3):
     nearest = min(rows, key=lambda r: r["calibrated_max_error_mm"])
     result = {"points_complete": len(rows), "points_incomplete": [{"point": p, "needles": s} for p, s in incomplete],
               "responses": resp, "hsic": {r: {n: {"r2_hsic": v[0], "p_value": v[1]} for n, v in table[r].items()} for r in resp},
-              "surrogates": surrogates, "joint": joint, "nearest_run_point": nearest, "measured_mm": MEASURED_MM}
+              "surrogates": surrogates, "chaos": chaos, "joint": joint, "nearest_run_point": nearest, "measured_mm": MEASURED_MM}
     with open(os.path.join(folder, "surrogate.json.tmp"), "w") as f:
         json.dump(result, f, indent=1)
     os.replace(os.path.join(folder, "surrogate.json.tmp"), os.path.join(folder, "surrogate.json"))
@@ -456,6 +519,14 @@ def analyze(study, out, permutations=2000, top=3):
         md.append(f"| {s['response']} | {', '.join(s['factors'])} | {s['leave_one_out_q2']:.2f} | {s['leave_one_out_rmse']:.3f} | "
                   f"{s['observed_min']:+.3f}..{s['observed_max']:+.3f} | {s['box_min']['value']:+.3f}..{s['box_max']['value']:+.3f} | "
                   f"{MEASURED_MM[needle] / MEASURED_MM['SB']:+.3f} |")
+    md.append("")
+    md.append("Sparse additive polynomial chaos of each ratio over all the factors (each factor's polynomials to degree 2, or 1 where too few points, no interactions; LARS): first-order / total Sobol' indices of the "
+              "factors with a total index of at least 0.05, and the chaos's leave-one-out Q2 (below about 0.5 the indices say little):")
+    md.append("")
+    for c in chaos:
+        big = sorted(((n, v) for n, v in c["sobol"].items() if v[1] >= 0.05), key=lambda kv: -kv[1][1])
+        md.append(f"- {c['response']} (degree {c['degree']}, Q2 {c['leave_one_out_q2']:.2f}, {c['terms']} terms): "
+                  + (", ".join(f"{n} {v[0]:.2f} / {v[1]:.2f}" for n, v in big) if big else "no factor reaches 0.05"))
     md.append("")
     md.append("Calibrated on SB to first order (each needle's deflection = the measured SB's x its ratio to SB), against the experiment:")
     md.append("")

@@ -110,6 +110,14 @@ with tempfile.TemporaryDirectory() as tmp:
     check(amb["leave_one_out_q2"] > 0.9, f"the AMB surrogate predicts left-out points (Q2 {amb['leave_one_out_q2']:.3f})")
     check(abs(amb["box_min"]["value"] - (-1.3)) < 0.05 and abs(amb["box_max"]["value"] - (-1.3 + 0.8 + 0.5)) < 0.05,
           f"the AMB surrogate reaches the function's extremes over the box ({amb['box_min']['value']:.3f}, {amb['box_max']['value']:.3f})")
+    # The chaos of AMB's ratio is exact (the function is of degree 2 in the scaled factors): its Sobol' indices are the
+    # closed form's, Var(0.8 g) / Var and Var(0.5 f^2) / Var with g, f uniform on [0, 1].
+    var_g, var_f = 0.64 / 12, 0.25 * (1 / 5 - 1 / 9)
+    chaos = next(c for c in result["chaos"] if c["response"] == "ratio_AMB")
+    check(chaos["leave_one_out_q2"] > 0.9, f"the chaos of AMB's ratio predicts left-out points (Q2 {chaos['leave_one_out_q2']:.3f}, degree {chaos['degree']})")
+    check(abs(chaos["sobol"]["groove_start_mm"][0] - var_g / (var_g + var_f)) < 0.05 and abs(chaos["sobol"]["friction"][1] - var_f / (var_g + var_f)) < 0.05,
+          f"its Sobol' indices are the closed form's (groove {chaos['sobol']['groove_start_mm'][0]:.3f} against {var_g / (var_g + var_f):.3f}, "
+          f"friction {chaos['sobol']['friction'][1]:.3f} against {var_f / (var_g + var_f):.3f})")
     # The joint search's best point against the function's own minimax, by brute force over its two drivers.
     best = float("inf")
     for i in range(201):
