@@ -6,7 +6,8 @@
   checks every key and value) and counts points x needles cases.
 - The statistics, on a study whose "runs" are a known function written as case records: the HSIC screen finds the
   two factors the ratios depend on (p < 0.01) and gives the inert ones a far smaller index, and the kriging surrogate
-  of a smooth ratio predicts left-out points (Q2 > 0.9) and reaches the function's own extremes over the box.
+  of a smooth ratio predicts left-out points (Q2 > 0.9) and reaches the function's own extremes over the box, the
+  additive polynomial chaos gives the closed form's Sobol' indices, and the joint search finds the function's minimax.
 - One more parameter fitted honestly (second_parameter.py): on ratios linear in the value, each fit and each held-out
   prediction has a closed form; its sweep file passes `needle sweep --count`.
 - Bad study files are refused with one line and exit 2.
