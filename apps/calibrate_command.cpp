@@ -18,6 +18,7 @@
 
 #include "apps/cli_checks.h"
 #include "studies/calibration_steps.h"
+#include "runs/provenance_json.h"
 #include "runs/insertion_run.h"
 #include "apps/scene_overrides.h"
 #include "runs/json_file.h"
@@ -156,7 +157,8 @@ void calibrate(const CalibrateOptions& o) {
                     {"sensitivity_mm_per_MPa", std::isfinite(slope) ? json(slope) : json(nullptr)},
                     {"relative_sensitivity", std::isfinite(slope) ? json(slope * best.E_MPa / best.deflection_mm) : json(nullptr)},
                     {"sensitivity_from_E_MPa", std::isfinite(slope) ? json::array({best.E_MPa, runs[*partner].E_MPa}) : json(nullptr)},
-                    {"runs", list}};
+                    {"runs", list},
+                    {"provenance", provenance_json()}};
   write_file_atomically((dir / "calibration.json").string(), [&](const std::string& scratch) { std::ofstream(scratch) << out.dump(2) << "\n"; });
   LinePlot plot;
   plot.title = fmt::format("Calibration of the tissue's E on {} (target {:+.2f} mm)", o.preset, o.target_mm);

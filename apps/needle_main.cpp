@@ -9,6 +9,8 @@
 #include <sstream>
 #include <string>
 
+#include "core/provenance.h"
+
 #include "apps/material_test_command.h"
 #include "apps/bench_command.h"
 #include "apps/calibrate_command.h"
@@ -61,6 +63,7 @@ std::string one_line(const char* what) {
 
 int main(int argc, char** argv) {
   CLI::App app{"needle: design biopsy needle tips - grinding CAD, meshing and insertion simulation"};
+  app.set_version_flag("--version", needle::provenance_line(), "Print the toolkit's version and the commit it was built from, and exit");
   app.require_subcommand(1);
   needle::add_tip_command(app);
   needle::add_mesh_command(app);

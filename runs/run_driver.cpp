@@ -7,6 +7,7 @@
 #include "core/interrupt.h"
 #include "core/parallel.h"
 #include "core/solver_error.h"
+#include "runs/provenance_json.h"
 
 namespace needle {
 
@@ -86,6 +87,7 @@ void drive_run(const Scene& scene, const RunOptions& o, const std::function<std:
       {"solve_s", solve_s},
       {"peak_memory_MiB", peak_memory_MiB()},
       {"threads", hardware_threads()},
+      {"provenance", provenance_json()},
   };
   model.add_summary(summary, solve_s);
   {

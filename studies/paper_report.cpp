@@ -11,6 +11,7 @@
 
 #include "runs/csv_table.h"
 #include "runs/json_file.h"
+#include "runs/provenance_json.h"
 #include "runs/run_summary.h"
 #include "studies/paper_observations.h"
 #include "studies/run_model_description.h"
@@ -309,7 +310,8 @@ void write_paper_report(const PaperReportInput& in) {
                    "that tissue fills, measured in the needle's own frame at the end of insertion (report.md, docs/paper.md)"},
                   {"targets", target_list},
                   {"tissue", tissue},
-                  {"reference", fs::proximate(in.reference_path).string()}};
+                  {"reference", fs::proximate(in.reference_path).string()},
+                  {"provenance", provenance_json()}};
   for (const ModelResults& m : replicas) results["replicas"].push_back({{"label", m.label}, {"results", m.path}});
   if (const json observations = paper_observations_json(observed); !observations.empty()) results["observations"] = observations;
 

@@ -11,6 +11,7 @@
 #include "geometry/mesh_io.h"
 #include "plot/heat_map.h"
 #include "plot/line_plot.h"
+#include "runs/provenance_json.h"
 #include "runs/json_file.h"
 #include "studies/paper_results.h"
 
@@ -238,6 +239,7 @@ void write_sweep_table(const fs::path& dir, const SweepPlan& plan, const std::ve
                     {{"cases", rows.size()}, {"finished", counts.finished}, {"stopped", counts.stopped}, {"infeasible", counts.infeasible},
                      {"timed_out", counts.timed_out}, {"failed", counts.failed}, {"pending", counts.pending}}},
                    {"deflection_zero_crossings", zeros},
+                   {"provenance", provenance_json()},  // the code that wrote the table (each run's summary names its own)
                    {"cases", cases}};
   write_file_atomically((dir / "sweep.json").string(), [&](const std::string& scratch) { std::ofstream(scratch) << table.dump(2) << "\n"; });
   if (!plan.variables.empty() && numeric_variable(rows, plan.variables.front()) && plan.design == "grid")

@@ -91,6 +91,24 @@ TEST_CASE("Bad scenes name the file, the line and the key", "[apps][scene]") {
   CHECK(m.find("no bore") != std::string::npos);
 }
 
+TEST_CASE("needle --version names the version and the commit the binary was built from", "[apps]") {
+  const auto version = run("--version");
+  REQUIRE(version.exit_code == 0);
+  INFO(version.out);
+  CHECK(version.out.rfind("needle 0.", 0) == 0);
+  // Built in a git work tree (a clone, as CI builds it): the commit is the work tree's HEAD, looked up independently here.
+  const fs::path source(NEEDLE_SOURCE_DIR);
+  if (fs::exists(source / ".git")) {
+    FILE* pipe = popen(("git -C " + source.string() + " rev-parse --short=12 HEAD 2>/dev/null").c_str(), "r");
+    REQUIRE(pipe);
+    char buffer[64] = {0};
+    const size_t n = fread(buffer, 1, sizeof buffer - 1, pipe);
+    pclose(pipe);
+    const std::string head = std::string(buffer, n).substr(0, 12);
+    if (head.size() == 12) CHECK(version.out.find("(commit " + head) != std::string::npos);
+  }
+}
+
 TEST_CASE("needle simulate: bad scenes exit non-zero and leave no run folder", "[apps][scene][slow]") {
   const fs::path dir = fresh_folder("bad");
   const std::vector<std::string> scenes = {
@@ -127,6 +145,11 @@ TEST_CASE("needle simulate: a rod pushed through the cannula writes a complete r
   CHECK(summary["energy_balance_error"].get<double>() < 0.005);
   CHECK(std::abs(summary["deflection_mm"].get<double>()) < 1e-3);
   CHECK(summary["tip_displacement_mm"][0].get<double>() == Approx(4.0).epsilon(1e-3));
+  // The run names the code that made it, as `needle --version` does.
+  const auto version = run("--version");
+  REQUIRE(version.exit_code == 0);
+  CHECK(version.out.find("(commit " + summary["provenance"]["commit"].get<std::string>()) != std::string::npos);
+  CHECK(version.out.find("needle " + summary["provenance"]["version"].get<std::string>() + " ") == 0);
   // The history's last row matches the summary, and its drive work equals KE + strain energy.
   std::ifstream csv(dir / "run" / "history.csv");
   std::string header, line, last;

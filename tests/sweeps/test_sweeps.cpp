@@ -135,6 +135,7 @@ TEST_CASE("needle sweep gives one table on worker processes, on MPI ranks and as
   REQUIRE(jobs.exit_code == 0);
   const json table = read_json(dir / "jobs" / "sweep.json");
   CHECK(table["counts"]["cases"] == 6);
+  CHECK(table["provenance"]["commit"].is_string());  // the code that wrote the table
   CHECK(table["counts"]["finished"] == 4);
   CHECK(table["counts"]["infeasible"] == 2);
   for (const json& c : table["cases"]) {
