@@ -70,6 +70,7 @@ void run(const SweepOptions& o) {
   }
   const int task = o.task_index >= 0 ? o.task_index : batch_array_task_index();
   if (task >= 0) {  // one case: a worker process, or a batch array's task
+    die_with_sweep_parent();
     NEEDLE_REQUIRE(task < static_cast<int>(plan.cases.size()),
                    fmt::format("--task-index {}: the sweep has cases 0 to {}", task, plan.cases.size() - 1));
     claim_study_folder(dir, "sweep_plan.json", stored_plan);

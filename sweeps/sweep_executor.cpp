@@ -10,6 +10,7 @@
 #include <map>
 #include <signal.h>
 #include <spawn.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <thread>
 #include <unistd.h>
@@ -34,6 +35,9 @@ std::string duration_words(double s) {
   return fmt::format("{:.1f} h", s / 3600);
 }
 
+// The environment variable that tells a worker which sweep process started it.
+constexpr const char* kParentVariable = "NEEDLE_SWEEP_PARENT_PID";
+
 // Starts `needle sweep FILE --out DIR --task-index I --threads T --quiet` with its output in the case's worker.log.
 pid_t start_worker(const SweepCase& c, const fs::path& dir, const SweepWorkers& w) {
   const fs::path folder = case_folder(dir, c.name);
@@ -48,8 +52,15 @@ pid_t start_worker(const SweepCase& c, const fs::path& dir, const SweepWorkers& 
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
   posix_spawn_file_actions_adddup2(&actions, 1, 2);
+  // The worker's environment: this one's, and this process's pid for die_with_sweep_parent.
+  std::vector<std::string> env = {std::string(kParentVariable) + "=" + std::to_string(getpid())};
+  for (char** e = environ; *e; ++e)
+    if (std::strncmp(*e, kParentVariable, std::strlen(kParentVariable)) != 0 || (*e)[std::strlen(kParentVariable)] != '=') env.emplace_back(*e);
+  std::vector<char*> envp;
+  for (std::string& e : env) envp.push_back(e.data());
+  envp.push_back(nullptr);
   pid_t pid = 0;
-  const int error = posix_spawn(&pid, "/proc/self/exe", &actions, nullptr, argv.data(), environ);
+  const int error = posix_spawn(&pid, "/proc/self/exe", &actions, nullptr, argv.data(), envp.data());
   posix_spawn_file_actions_destroy(&actions);
   if (error != 0) throw std::runtime_error(fmt::format("cannot start a sweep worker: {}", std::strerror(error)));
   return pid;
@@ -154,6 +165,15 @@ void run_sweep_with_workers(const SweepPlan& plan, const fs::path& dir, const Sw
   if (watch.signal())
     throw Interrupted(watch.signal(), fmt::format("the sweep was interrupted ({}): finished cases stay in {}; the same command goes on from there",
                                                   signal_name(watch.signal()), dir.string()));
+}
+
+void die_with_sweep_parent() {
+  const char* parent = std::getenv(kParentVariable);
+  if (!parent) return;
+  const pid_t expected = static_cast<pid_t>(std::atol(parent));
+  prctl(PR_SET_PDEATHSIG, SIGTERM);
+  // The parent may have died before the line above: then this process was handed to another and must not run.
+  if (getppid() != expected) throw Interrupted(SIGTERM, fmt::format("the sweep that started this worker (pid {}) is gone; the case runs again next time", expected));
 }
 
 int batch_array_task_index() {

@@ -41,6 +41,11 @@ void run_sweep_with_workers(const SweepPlan& plan, const std::filesystem::path& 
 // The cases of the plan not done yet in dir.
 std::vector<SweepCase> cases_to_run(const SweepPlan& plan, const std::filesystem::path& dir);
 
+// In a worker process this sweep started (the environment names the parent's pid): the kernel sends it SIGTERM when
+// its parent dies, even by SIGKILL, so that no orphan goes on running a case the next run of the sweep starts again;
+// a worker whose parent is gone already stops at once (Interrupted). Nothing outside a sweep's worker.
+void die_with_sweep_parent();
+
 // The case index a batch array hands this process: the environment's SLURM_ARRAY_TASK_ID, or -1 when not set.
 int batch_array_task_index();
 

@@ -255,6 +255,31 @@ TEST_CASE("A sweep interrupted midway loses no finished case and repeats none wh
   CHECK(other.out.find("holds another study") != std::string::npos);
 }
 
+TEST_CASE("A sweep killed by SIGKILL leaves no worker running, and its rerun finishes every case with none failed", "[sweeps][gmsh][lspg][slow]") {
+  const fs::path dir = fresh_folder("sweep_sigkill");
+  write_tiny_scene(dir);
+  // Cases of about 15 s each (a slow drive): without the parent's death signal the workers would still be running 5 s
+  // after the parent is killed; with it they stop within the step (or the model's build) they are in.
+  write(dir / "sweep.json", R"({"base": {"scene": "scene.json"}, "model": "fast", "set": {"motion.travel_mm": 3, "motion.speed_m_per_s": 1},)"
+                            R"("variables": {"tissue.friction": [0.1, 0.2]}})");
+  const fs::path out = dir / "out";
+  const std::string workers = "pgrep -f -- '--out " + out.string() + " --task-index' | wc -l";
+  const std::string script = std::string(NEEDLE_BINARY) + " sweep " + (dir / "sweep.json").string() + " --out " + out.string() +
+                             " --jobs 2 --quiet & pid=$!; while [ ! -f " + (out / "cases" / "case_0001" / "worker.log").string() +
+                             " ]; do sleep 0.05; done; sleep 0.3; echo running=$(" + workers + "); kill -KILL $pid; for i in $(seq 50); do n=$(" + workers + "); [ $n = 0 ] && break; sleep 0.1; done; echo left=$n";
+  write(dir / "kill.sh", script);
+  const std::string first = stderr_of("bash " + (dir / "kill.sh").string());
+  INFO(first);
+  CHECK(first.find("running=0") == std::string::npos);  // the workers were running when the parent died
+  CHECK(first.find("left=0") != std::string::npos);     // and none outlived it
+  const Result again = run("sweep " + (dir / "sweep.json").string() + " --out " + out.string(), true);
+  INFO(again.out);
+  REQUIRE(again.exit_code == 0);
+  const json table = read_json(out / "sweep.json");
+  CHECK(table["counts"]["finished"] == 2);
+  CHECK(table["counts"]["failed"] == 0);
+}
+
 TEST_CASE("Bad sweep and optimisation files get one clear error before any case runs", "[sweeps][slow]") {
   const fs::path dir = fresh_folder("sweep_bad");
   write_tiny_scene(dir);
