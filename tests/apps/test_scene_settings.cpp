@@ -57,7 +57,7 @@ TEST_CASE("apply_scene_settings sets dotted keys with units, replaces a key's ot
   CHECK(refusal("needle.length_mm.x=1").find("length_mm is a value, not a section") != std::string::npos);
 }
 
-TEST_CASE("--set touches only its own key and that key's unit spellings: every key next to a longer key of the same prefix keeps its neighbour",
+TEST_CASE("A --set setting touches only its own key and that key's unit spellings: every key next to a longer key of the same prefix keeps its neighbour",
           "[apps][scene]") {
   // Every optional key written, so that every pair of keys the effective scene can hold is here.
   const needle::Scene base = needle::parse_scene(
