@@ -508,7 +508,10 @@ def analyze(study, out, permutations=2000, top=3):
         json.dump(result, f, indent=1)
     os.replace(os.path.join(folder, "surrogate.json.tmp"), os.path.join(folder, "surrogate.json"))
     md = [f"# Global sensitivity: {len(rows)} complete design points x {len(study['needles'])} needles", ""]
-    md.append("R2-HSIC index (p-value by permutation) of each factor for each response; bold: p < 0.05.")
+    bonferroni = 0.05 / len(study["factors"])
+    md.append(f"R2-HSIC index (p-value by permutation) of each factor for each response; bold: p < 0.05; and a dagger where "
+              f"p < {bonferroni:.4f}, which holds for the {len(study['factors'])} factors of a response together (Bonferroni): with "
+              f"{len(study['factors']) * len(resp)} tests, about {0.05 * len(study['factors']) * len(resp):.0f} fall below 0.05 by chance alone.")
     md.append("")
     md.append("| factor | " + " | ".join(resp) + " |")
     md.append("|---" * (len(resp) + 1) + "|")
@@ -517,7 +520,7 @@ def analyze(study, out, permutations=2000, top=3):
         for r in resp:
             r2, p = table[r][fac["name"]]
             cell = f"{r2:.3f} ({p:.3f})"
-            cells.append(f"**{cell}**" if p < 0.05 else cell)
+            cells.append((f"**{cell}**" if p < 0.05 else cell) + (" †" if p < bonferroni else ""))
         md.append(f"| {fac['name']} | " + " | ".join(cells) + " |")
     md.append("")
     md.append("Kriging surrogates of the ratios to SB and of the plateau AMB - LMB on their three most influential factors (the others "
