@@ -37,7 +37,9 @@ CheckedTarget checked_target(const std::string& dir, bool overwrite) {
   namespace fs = std::filesystem;
   NEEDLE_REQUIRE(!dir.empty(), "--out needs a folder");
   const fs::path folder(dir);
-  const fs::path target = fs::weakly_canonical(fs::absolute(folder));
+  fs::path target = fs::weakly_canonical(fs::absolute(folder));
+  // "runs/SB/" names the folder runs/SB, as a shell's completion writes it.
+  while (!target.has_filename() && target.has_parent_path() && target != target.root_path()) target = target.parent_path();
   // "." and ".." name the folder itself: its parent is the one above.
   const fs::path parent = target.has_parent_path() && target != target.root_path() ? target.parent_path() : target;
   NEEDLE_REQUIRE(fs::is_directory(parent), fmt::format("the folder '{}' that should hold '{}' does not exist", parent.string(), dir));
@@ -62,6 +64,7 @@ void RunFolder::check_target(const std::string& dir, bool overwrite) { checked_t
 RunFolder::RunFolder(const std::string& dir, bool overwrite) : final_(dir), overwrite_(overwrite) {
   namespace fs = std::filesystem;
   const CheckedTarget checked = checked_target(dir, overwrite);
+  final_ = fs::path(dir).has_filename() ? fs::path(dir) : checked.target;  // "runs/SB/": the folder runs/SB
   partial_ = checked.parent / ("." + checked.target.filename().string() + ".partial");
   fs::remove_all(partial_);
   fs::create_directories(partial_);

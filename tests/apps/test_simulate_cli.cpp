@@ -167,11 +167,16 @@ TEST_CASE("needle simulate: a rod pushed through the cannula writes a complete r
   // The effective scene runs again to the same result, and an existing folder is refused.
   const auto again = run("simulate " + (dir / "run" / "scene.json").string() + " --out " + (dir / "run").string() + " --quiet");
   CHECK(again.exit_code == 2);
-  const auto replay = run("simulate " + (dir / "run" / "scene.json").string() + " --out " + (dir / "run2").string() + " --quiet");
+  // Written with a trailing slash, as a shell's completion gives it: the folder run2, no stray .partial left.
+  const auto replay = run("simulate " + (dir / "run" / "scene.json").string() + " --out " + (dir / "run2").string() + "/ --quiet", true);
+  INFO(replay.out);
   REQUIRE(replay.exit_code == 0);
   nlohmann::json summary2;
   std::ifstream(dir / "run2" / "summary.json") >> summary2;
   CHECK(summary2["deflection_mm"].get<double>() == Approx(summary["deflection_mm"].get<double>()).margin(1e-12));
+  CHECK(!fs::exists(dir / ".run2.partial"));
+  const auto existing = run("simulate " + (dir / "run" / "scene.json").string() + " --out " + (dir / "run2").string() + "/ --quiet", true);
+  CHECK(existing.exit_code == 2);  // and an existing one is refused, slash or not
 }
 
 TEST_CASE("needle stiffness --json reports compliance and frequencies with the beam reference", "[apps][needle][gmsh][slow]") {
