@@ -10,6 +10,7 @@
 #include "runs/run_driver.h"
 #include "runs/run_folder.h"
 #include "runs/scene_needle.h"
+#include "runs/scene_particles.h"
 #include "core/input_error.h"
 #include "mesher/particle_lattice.h"
 #include "mesher/vtk_files.h"
@@ -30,25 +31,6 @@ namespace {
 
 using nlohmann::json;
 using Clock = std::chrono::steady_clock;
-
-ParticleSet scene_particles(const Scene& scene) {
-  const TissueScene& t = scene.tissue;
-  TissueBox box;
-  const bool half = scene.needle.half_model;
-  box.min_mm = {t.entry_x_mm, -0.5 * t.size_mm.y(), half ? 0.0 : -t.size_mm.z()};
-  box.max_mm = {t.entry_x_mm + t.size_mm.x(), 0.5 * t.size_mm.y(), t.size_mm.z()};
-  if (!half) box.faces[4] = FaceCondition::fixed;
-  LatticeOptions lattice;
-  lattice.spacing_mm = t.spacing_mm;
-  if (t.path_refinement > 1) {
-    const double w = t.path_half_width_mm;
-    NEEDLE_REQUIRE(w < 0.5 * t.size_mm.y() && w < t.size_mm.z(),
-                   fmt::format("tissue: path_half_width_mm {} mm reaches the block's faces", w));
-    lattice.region_of_interest =
-        RegionOfInterest{{box.min_mm.x(), -w, half ? 0.0 : -w}, {box.max_mm.x(), w, w}, t.path_refinement, t.path_grading};
-  }
-  return make_particle_lattice(box, lattice);
-}
 
 // Broken bonds per particle.
 Eigen::VectorXd broken_bonds(const SpgTissue& tissue) {

@@ -1,6 +1,7 @@
 #include "runs/scene.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fmt/format.h>
 
@@ -106,6 +107,7 @@ void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc) {
   t.size_mm = o.vector3("size_mm", t.size_mm);
   NEEDLE_REQUIRE((t.size_mm.array() > 0).all(), fmt::format("{} must be three positive lengths", o.where("size_mm")));
   t.entry_x_mm = o.quantity("entry_x", Dimension::length, t.entry_x_mm, any_finite());
+  t.offset_y_mm = o.quantity("offset_y", Dimension::length, t.offset_y_mm, any_finite());
   t.spacing_mm = o.quantity("spacing", Dimension::length, t.spacing_mm, positive());
   t.path_refinement = o.integer("path_refinement", t.path_refinement, 1, 8);
   t.path_half_width_mm = o.quantity("path_half_width", Dimension::length, t.path_half_width_mm, positive());
@@ -166,6 +168,10 @@ void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc) {
     t.separation.crack.lead_mm = c.quantity("crack_lead", Dimension::length, t.separation.crack.lead_mm, non_negative());
     c.finish();
   }
+  // The path (y = z = 0) stays inside the block, with a rod's radius and a coarse spacing to spare.
+  NEEDLE_REQUIRE(std::abs(t.offset_y_mm) + 0.5 + t.spacing_mm < 0.5 * t.size_mm.y(),
+                 fmt::format("{}: {} mm moves the block's side faces within a rod's radius and a spacing of the path (size_mm y {} mm)",
+                             o.where("offset_y_mm"), t.offset_y_mm, t.size_mm.y()));
   o.finish();
 }
 
@@ -264,6 +270,7 @@ json scene_to_json(const Scene& s) {
     tissue["contact"]["slit_lead_mm"] = t.separation.slit.lead_mm;
   }
   if (t.cutting.pressure_MPa > 0) tissue["contact"]["cutting_pressure_MPa"] = t.cutting.pressure_MPa;
+  if (t.offset_y_mm != 0) tissue["offset_y_mm"] = t.offset_y_mm;
   if (t.contact.law != "penalty") tissue["contact"]["law"] = t.contact.law;
   if (t.separation.crack.enabled()) {
     tissue["contact"]["crack_reach_mm"] = t.separation.crack.reach_mm;

@@ -48,6 +48,7 @@ struct TissueScene {
   bool enabled = false;                     // false: the needle and cannula alone (needle simulate)
   Eigen::Vector3d size_mm{40.0, 8.0, 2.0};  // x from entry_x, y centred on the axis, z from the symmetry plane
   double entry_x_mm = 0.0;                  // the block's entry face (tip point A starts at x = 0)
+  double offset_y_mm = 0.0;                 // the block and its lattice shifted across the path: the lattice's phase in y
   double spacing_mm = 0.4, dilation = 1.8, friction = 0.18;
   // Finer particles around the needle's path (y = z = 0), over the block's whole length: within
   // |y| <= path_half_width_mm and |z| <= path_half_width_mm the spacing is spacing_mm / path_refinement
