@@ -38,10 +38,10 @@ TEST_CASE("tissue.offset_y_mm reads back, is written only when set, and may not 
   CHECK(shifted.tissue.offset_y_mm == Approx(0.05));
   CHECK(needle::scene_to_json(shifted)["tissue"]["offset_y_mm"].get<double>() == Approx(0.05));
   try {
-    needle::parse_scene(R"({"tissue": {"enabled": true, "size_mm": [40, 2, 2], "offset_y_mm": 0.2}})", "bad.json");
+    needle::parse_scene(R"({"tissue": {"enabled": true, "size_mm": [40, 2, 2], "offset_y_mm": 0.6}})", "bad.json");
     FAIL("accepted");
   } catch (const needle::InputError& e) {
-    CHECK(std::string(e.what()).find("tissue.offset_y_mm: 0.2 mm moves the block's side faces within a rod's radius and a spacing of the path") !=
+    CHECK(std::string(e.what()).find("tissue.offset_y_mm: 0.6 mm moves the block's side faces within a rod's radius of the path") !=
           std::string::npos);
   }
 }
