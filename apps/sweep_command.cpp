@@ -29,13 +29,14 @@ struct SweepOptions {
   bool collect = false, count = false, quiet = false;
 };
 
-void print_table_summary(const fs::path& dir, const SweepPlan& plan, const std::vector<CaseResult>& rows) {
+SweepCounts print_table_summary(const fs::path& dir, const SweepPlan& plan, const std::vector<CaseResult>& rows) {
   const SweepCounts c = count_cases(rows);
   fmt::print("sweep: {} cases: {} finished, {} stopped, {} infeasible, {} timed out, {} failed, {} not run yet\n", rows.size(), c.finished, c.stopped,
              c.infeasible, c.timed_out, c.failed, c.pending);
   for (const DeflectionZero& z : deflection_zeros(plan.variables, rows))
     fmt::print("sweep: the deflection crosses zero at {} = {:.4g}{}\n", z.variable, z.value, z.others.empty() ? "" : " (" + describe_values(z.others) + ")");
   fmt::print("sweep: table {} and {}\n", (dir / "sweep.csv").string(), (dir / "sweep.json").string());
+  return c;
 }
 
 // Writes the table, then says whether every case finished: StudyIncomplete (exit 3) when some stopped, timed out,
@@ -43,8 +44,7 @@ void print_table_summary(const fs::path& dir, const SweepPlan& plan, const std::
 void write_and_print_table(const fs::path& dir, const SweepPlan& plan) {
   const std::vector<CaseResult> rows = collect_case_records(dir, plan.cases);
   write_sweep_table(dir, plan, rows, std::string(NEEDLE_DATA_DIR) + "/paper/reference.json");
-  print_table_summary(dir, plan, rows);
-  const SweepCounts c = count_cases(rows);
+  const SweepCounts c = print_table_summary(dir, plan, rows);
   const int unfinished = c.stopped + c.timed_out + c.failed + c.pending;
   if (unfinished > 0)
     throw StudyIncomplete(fmt::format("{} of {} cases did not finish ({} stopped, {} timed out, {} failed, {} not run): the table holds the others; "

@@ -43,18 +43,30 @@ Eigen::VectorXd broken_bonds(const SpgTissue& tissue) {
   return count;
 }
 
+// The particles pulled back into the needle's reference frame (as the contact does), and the tissue block's x range there.
+struct PulledBackTissue {
+  std::vector<Eigen::Vector3d> points;
+  double min_x_mm = 0, max_x_mm = 0;
+};
+
+PulledBackTissue pulled_back_tissue(CoupledInsertion& run, const Scene& scene) {
+  const double drive_x = run.needle().drive_displacement_mm().x();
+  return {run.contact_model().pull_back(run.tissue().particles().position_mm, run.needle().positions_mm()),
+          scene.tissue.entry_x_mm - drive_x, scene.tissue.entry_x_mm + scene.tissue.size_mm.x() - drive_x};
+}
+
 // The groove fill of the run's current state (groove_fill.h); empty without a groove.
 GrooveFill run_groove_fill(CoupledInsertion& run, const SceneNeedle& needle, const Scene& scene) {
   if (!needle.groove) return {};
   const TissueParticles& p = run.tissue().particles();
   NeedleTissueContact& contact = run.contact_model();
+  PulledBackTissue tissue = pulled_back_tissue(run, scene);
   GrooveFillInput in;
   in.groove = *needle.groove;
   in.radius_mm = needle.radius_mm;
-  const double drive_x = run.needle().drive_displacement_mm().x();
-  in.tissue_min_x_mm = scene.tissue.entry_x_mm - drive_x;
-  in.tissue_max_x_mm = scene.tissue.entry_x_mm + scene.tissue.size_mm.x() - drive_x;
-  in.reference_points = contact.pull_back(p.position_mm, run.needle().positions_mm());
+  in.tissue_min_x_mm = tissue.min_x_mm;
+  in.tissue_max_x_mm = tissue.max_x_mm;
+  in.reference_points = std::move(tissue.points);
   in.spacing_mm = p.spacing_mm;
   in.touches_floor.assign(in.reference_points.size(), 0);
   const ContactSurface& surface = contact.surface();
@@ -68,8 +80,11 @@ GrooveFill run_groove_fill(CoupledInsertion& run, const SceneNeedle& needle, con
 StrainProbes run_strain_probes(CoupledInsertion& run, const SceneNeedle& needle, const Scene& scene) {
   const TissueParticles& p = run.tissue().particles();
   NeedleTissueContact& contact = run.contact_model();
+  PulledBackTissue tissue = pulled_back_tissue(run, scene);
   StrainProbeInput in;
-  in.reference_points = contact.pull_back(p.position_mm, run.needle().positions_mm());
+  in.reference_points = std::move(tissue.points);
+  in.tissue_min_x_mm = tissue.min_x_mm;
+  in.tissue_max_x_mm = tissue.max_x_mm;
   in.spacing_mm = p.spacing_mm;
   in.min_principal_strain.resize(p.elastic_left_cauchy_green.size());
   for (size_t i = 0; i < in.min_principal_strain.size(); ++i) in.min_principal_strain[i] = min_principal_log_strain(p.elastic_left_cauchy_green[i]);
@@ -81,9 +96,6 @@ StrainProbes run_strain_probes(CoupledInsertion& run, const SceneNeedle& needle,
   in.tip_point = needle.tip_point;
   in.groove = needle.groove;
   in.radius_mm = needle.radius_mm;
-  const double drive_x = run.needle().drive_displacement_mm().x();
-  in.tissue_min_x_mm = scene.tissue.entry_x_mm - drive_x;
-  in.tissue_max_x_mm = scene.tissue.entry_x_mm + scene.tissue.size_mm.x() - drive_x;
   return probe_strains(in);
 }
 

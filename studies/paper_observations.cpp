@@ -3,6 +3,8 @@
 #include <cmath>
 #include <fmt/format.h>
 
+#include "runs/json_file.h"
+
 namespace needle {
 using json = nlohmann::json;
 
@@ -47,23 +49,21 @@ const char* region_words(const std::string& region) {
   return "in the groove";
 }
 
-double number(const json& j, const char* key) { return j.contains(key) && j[key].is_number() ? j[key].get<double>() : std::nan(""); }
-
 // Ours, as text, or "" where the run holds nothing for it.
 std::string ours(const Observation& o, const json& summary) {
   const std::string what = o.what;
   if (what == "groove contact") {
     if (!summary.contains("groove") || !summary["groove"].is_object()) return "";
-    const double floor = number(summary["groove"], "floor_contact_fraction"), gap = number(summary["groove"], "mean_gap_mm");
+    const double floor = number_or_nan(summary["groove"], "floor_contact_fraction"), gap = number_or_nan(summary["groove"], "mean_gap_mm");
     return std::isfinite(floor) ? fmt::format("floor contact {:.2f}, mean gap {:.3f} mm", floor, gap) : "";
   }
   if (!summary.contains("strain_probes") || !summary["strain_probes"].contains(o.when)) return "";
   const json& probe = summary["strain_probes"][o.when];
-  if (what == "deflection") return fmt::format("{:+.3f} mm at {:.1f} mm", number(probe, "deflection_mm"), number(probe, "insertion_mm"));
+  if (what == "deflection") return fmt::format("{:+.3f} mm at {:.1f} mm", number_or_nan(probe, "deflection_mm"), number_or_nan(probe, "insertion_mm"));
   const json& r = probe.value(o.region, json::object());
   const int particles = r.value("particles", 0);
   if (particles == 0) return "no tissue there";
-  return fmt::format("{:.2f} (median {:.2f}; {} particles)", number(r, "p05"), number(r, "median"), particles);
+  return fmt::format("{:.2f} (median {:.2f}; {} particles)", number_or_nan(r, "p05"), number_or_nan(r, "median"), particles);
 }
 
 std::string where(const Observation& o) {

@@ -9,6 +9,13 @@
 
 namespace needle {
 
+bool in_groove_section(const GrooveBox& g, double R, const Eigen::Vector3d& X, double h) {
+  const double y = X.y(), floor = g.floor_y_mm;
+  if (y < floor - 0.5 * h || y >= R) return false;
+  const double y_width = std::max(y, floor);
+  return std::abs(X.z()) <= std::sqrt(std::max(0.0, R * R - y_width * y_width));
+}
+
 GrooveFill measure_groove_fill(const GrooveFillInput& in) {
   NEEDLE_REQUIRE(in.slice_mm > 0, "groove fill: the slice length must be positive");
   NEEDLE_REQUIRE(in.spacing_mm.size() == in.reference_points.size() && in.touches_floor.size() == in.reference_points.size(),
@@ -29,12 +36,8 @@ GrooveFill measure_groove_fill(const GrooveFillInput& in) {
     if (!X.allFinite()) continue;
     const double h = in.spacing_mm[i];
     if (X.x() + 0.5 * h < lo || X.x() - 0.5 * h > hi) continue;
-    // Inside the groove's section: above the floor (less half a particle), below the rod's top, within
-    // the section's half width at that height.
+    if (!in_groove_section(g, R, X, h)) continue;
     const double y = X.y();
-    if (y < floor - 0.5 * h || y >= R) continue;
-    const double y_width = std::max(y, floor);
-    if (std::abs(X.z()) > std::sqrt(std::max(0.0, R * R - y_width * y_width))) continue;
     ++out.particles_in_groove;
     const int first = std::max(0, static_cast<int>(std::floor((X.x() - 0.5 * h - lo) / slice)));
     const int last = std::min(slices - 1, static_cast<int>(std::floor((X.x() + 0.5 * h - lo) / slice)));

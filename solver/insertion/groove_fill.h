@@ -41,4 +41,9 @@ struct GrooveFill {
 
 GrooveFill measure_groove_fill(const GrooveFillInput& input);
 
+// Whether a particle of spacing h at X (reference frame) lies in the groove's cross-section: above the floor less half
+// a particle, below the rod's top (radius R), within the section's half width at that height. The x range is the
+// caller's.
+bool in_groove_section(const GrooveBox& groove, double radius_mm, const Eigen::Vector3d& X, double h);
+
 }  // namespace needle

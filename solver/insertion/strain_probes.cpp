@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/input_error.h"
+#include "solver/insertion/groove_fill.h"
 
 namespace needle {
 
@@ -70,15 +71,8 @@ StrainProbes probe_strains(const StrainProbeInput& in) {
       else if (!is_groove_surface(name) && X.x() <= A.x() && X.x() >= A.x() - in.tip_window_mm && X.y() <= A.y())
         below.push_back(strain);
     }
-    // The groove's section, as the groove fill takes it: above the floor less half a particle, below the rod's top,
-    // within the section's half width at that height.
-    if (in.groove && groove_hi > groove_lo) {
-      const double h = in.spacing_mm[i], floor = in.groove->floor_y_mm, y = X.y();
-      if (X.x() < groove_lo || X.x() > groove_hi || y < floor - 0.5 * h || y >= R) continue;
-      const double y_width = std::max(y, floor);
-      if (std::abs(X.z()) > std::sqrt(std::max(0.0, R * R - y_width * y_width))) continue;
-      groove.push_back(strain);
-    }
+    // The groove's section, as the groove fill takes it (groove_fill.h), over its length in the tissue.
+    if (in.groove && X.x() >= groove_lo && X.x() <= groove_hi && in_groove_section(*in.groove, R, X, in.spacing_mm[i])) groove.push_back(strain);
   }
   return {summarise(top), summarise(below), summarise(groove)};
 }

@@ -131,20 +131,35 @@ def sweep_file(study, batch):
     return sweep
 
 
-def write_batch(study, out, batch):
-    folder = os.path.join(out, f"batch_{batch}")
-    os.makedirs(folder, exist_ok=True)
-    path = os.path.join(folder, "sweep.json")
-    text = json.dumps(sweep_file(study, batch), indent=1) + "\n"
+def write_sweep_file(path, sweep):
+    """Writes a study's sweep file whole, or accepts the same one already there (a rerun); StudyError for another."""
+    text = json.dumps(sweep, indent=1) + "\n"
     if os.path.exists(path):
         with open(path) as f:
             if f.read() != text:
-                raise StudyError(f"{path} holds another design (the study file changed?): give a new --out")
+                raise StudyError(f"{path} holds another design (the study changed?): give a new --out")
     else:
         with open(path + ".tmp", "w") as f:
             f.write(text)
         os.replace(path + ".tmp", path)
     return path
+
+
+def case_records(cases_dir):
+    """(case folder, case.json) of every case a sweep has recorded in cases_dir, in case order."""
+    if not os.path.isdir(cases_dir):
+        return
+    for name in sorted(os.listdir(cases_dir)):
+        path = os.path.join(cases_dir, name, "case.json")
+        if os.path.exists(path):
+            with open(path) as f:
+                yield os.path.join(cases_dir, name), json.load(f)
+
+
+def write_batch(study, out, batch):
+    folder = os.path.join(out, f"batch_{batch}")
+    os.makedirs(folder, exist_ok=True)
+    return write_sweep_file(os.path.join(folder, "sweep.json"), sweep_file(study, batch))
 
 
 def run_batch(args, sweep_path):
@@ -178,27 +193,20 @@ def read_points(study, out):
         cases_dir = os.path.join(out, f"batch_{batch}", "sweep", "cases")
         for point, needle, values in batch_cases(study, batch):
             records.setdefault(point, {"values": values, "needles": {}})
-        if os.path.isdir(cases_dir):
-            for name in sorted(os.listdir(cases_dir)):
-                path = os.path.join(cases_dir, name, "case.json")
-                if not os.path.exists(path):
-                    continue
-                with open(path) as f:
-                    record = json.load(f)
-                label = record.get("label", "")
-                parts = label.split()
-                if len(parts) != 3 or parts[0] != "point":
-                    continue
-                point, needle = int(parts[1]), parts[2]
-                entry = {"status": record.get("status"), "reason": record.get("reason", ""),
-                         "deflection_mm": record.get("deflection_mm"), "groove_fill": record.get("groove_fill"),
-                         "runtime_s": record.get("runtime_s"), "floor_contact": None}
-                summary = os.path.join(cases_dir, name, "run", "summary.json")
-                if os.path.exists(summary):
-                    with open(summary) as f:
-                        s = json.load(f)
-                    entry["floor_contact"] = (s.get("groove") or {}).get("floor_contact_fraction")
-                records[point]["needles"][needle] = entry
+        for case_dir, record in case_records(cases_dir):
+            parts = record.get("label", "").split()
+            if len(parts) != 3 or parts[0] != "point":
+                continue
+            point, needle = int(parts[1]), parts[2]
+            entry = {"status": record.get("status"), "reason": record.get("reason", ""),
+                     "deflection_mm": record.get("deflection_mm"), "groove_fill": record.get("groove_fill"),
+                     "runtime_s": record.get("runtime_s"), "floor_contact": None}
+            summary = os.path.join(case_dir, "run", "summary.json")
+            if os.path.exists(summary):
+                with open(summary) as f:
+                    s = json.load(f)
+                entry["floor_contact"] = (s.get("groove") or {}).get("floor_contact_fraction")
+            records[point]["needles"][needle] = entry
         batch += 1
     return records
 

@@ -20,7 +20,7 @@ import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from global_sensitivity import MEASURED_MM, POOLED_SD_MM, StudyError  # noqa: E402
+from global_sensitivity import MEASURED_MM, POOLED_SD_MM, StudyError, case_records, write_sweep_file  # noqa: E402
 
 NEEDLES = ["SB", "LMB", "AMB", "HMB"]
 MULTI = ["LMB", "AMB", "HMB"]
@@ -36,14 +36,8 @@ def sweep_file(key, values, travel_mm):
 
 def read_ratios(out, key, values):
     """{value: {needle: ratio to SB}} for the values whose four needles finished; and the missing ones' reasons."""
-    cases_dir = os.path.join(out, "sweep", "cases")
     deltas, problems = {}, []
-    for name in sorted(os.listdir(cases_dir)) if os.path.isdir(cases_dir) else []:
-        path = os.path.join(cases_dir, name, "case.json")
-        if not os.path.exists(path):
-            continue
-        with open(path) as f:
-            r = json.load(f)
+    for _, r in case_records(os.path.join(out, "sweep", "cases")):
         label = r.get("label", "")
         value_text, needle = label.rsplit(" ", 1)
         value = float(value_text.split("=", 1)[1])
@@ -164,12 +158,7 @@ def main(argv):
         values.sort()
         if not args.analyze_only:
             os.makedirs(args.out, exist_ok=True)
-            path = os.path.join(args.out, "sweep.json")
-            text = json.dumps(sweep_file(args.key, values, args.travel_mm), indent=1) + "\n"
-            if os.path.exists(path) and open(path).read() != text:
-                raise StudyError(f"{path} holds another study: give a new --out")
-            with open(path, "w") as f:
-                f.write(text)
+            path = write_sweep_file(os.path.join(args.out, "sweep.json"), sweep_file(args.key, values, args.travel_mm))
             status = subprocess.call([args.needle, "sweep", path, "--out", os.path.join(args.out, "sweep"), "--jobs", str(args.jobs)])
             if status not in (0, 3):  # 3: some cases did not finish; the values whose four needles did are analysed
                 raise StudyError(f"needle sweep exited {status}")
