@@ -20,8 +20,15 @@ enum class FaceCondition { free, fixed, symmetry };
 
 // Particle flags (bits): a particle on two faces carries both faces' flags. kParticleOpenSymmetry is set
 // during a run (solver/separation/symmetry_slit.h): a symmetry particle a crack in the plane has released keeps
-// z >= 0 only, its mirror image being its contact partner.
-enum ParticleFlag : std::uint8_t { kParticleFixed = 1, kParticleSymmetry = 2, kParticleFreeSurface = 4, kParticleOpenSymmetry = 8 };
+// z >= 0 only, its mirror image being its contact partner. kParticleCrushed is set during a run too
+// (solver/separation/lip_release.h): the material there has lost its shear stiffness and keeps only its pressure.
+enum ParticleFlag : std::uint8_t {
+  kParticleFixed = 1,
+  kParticleSymmetry = 2,
+  kParticleFreeSurface = 4,
+  kParticleOpenSymmetry = 8,
+  kParticleCrushed = 16
+};
 
 struct TissueBox {
   Eigen::Vector3d min_mm{0.0, -4.0, 0.0};  // the paper's 40 x 8 x 2 mm half block, needle path y = z = 0

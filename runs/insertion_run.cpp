@@ -255,6 +255,9 @@ class InsertionRunModel : public RunModel {
                    "a cutting pressure needs a needle with tip facets: a ground tip from a preset, d_a or a recipe (not a plain rod or a mesh file)");
     NEEDLE_REQUIRE(!scene.tissue.separation.crack.enabled() || ground_tip,
                    "a crack from the tip point needs a needle with a ground tip point: a preset, d_a or a recipe (not a plain rod or a mesh file)");
+    NEEDLE_REQUIRE(!scene.tissue.separation.lip.enabled() || ground_tip,
+                   "a lip release below the tip point needs a needle with a ground tip point: a preset, d_a or a recipe (not a plain rod or a mesh "
+                   "file)");
     std::vector<std::unique_ptr<SeparationModel>> separations = make_separation_models(scene.tissue.separation, *surface_);
     setup_s_ = std::chrono::duration<double>(Clock::now() - start).count();
     NeedleDynamicsOptions dynamics = scene_dynamics_options(scene);

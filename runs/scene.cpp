@@ -166,6 +166,16 @@ void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc) {
     t.separation.crack.reach_mm = c.quantity("crack_reach", Dimension::length, t.separation.crack.reach_mm, non_negative());
     t.separation.crack.angles_deg = c.numbers("crack_angles_deg", t.separation.crack.angles_deg, within(-180.0, 180.0));
     t.separation.crack.lead_mm = c.quantity("crack_lead", Dimension::length, t.separation.crack.lead_mm, non_negative());
+    t.separation.lip.depth_mm = c.quantity("lip_release_depth", Dimension::length, t.separation.lip.depth_mm, non_negative());
+    t.separation.lip.below_mm = c.quantity("lip_release_below", Dimension::length, t.separation.lip.below_mm, non_negative());
+    {
+      const std::string mode = c.text("lip_release_mode", lip_release_mode_name(t.separation.lip.mode));
+      try {
+        t.separation.lip.mode = lip_release_mode_from_name(mode);
+      } catch (const InputError& e) {
+        throw InputError(fmt::format("{}: {}", c.where("lip_release_mode"), e.what()));
+      }
+    }
     c.finish();
   }
   // A shifted block keeps the path (y = z = 0) inside it, with a rod's radius to spare.
@@ -276,6 +286,11 @@ json scene_to_json(const Scene& s) {
     tissue["contact"]["crack_reach_mm"] = t.separation.crack.reach_mm;
     tissue["contact"]["crack_angles_deg"] = t.separation.crack.angles_deg;
     tissue["contact"]["crack_lead_mm"] = t.separation.crack.lead_mm;
+  }
+  if (t.separation.lip.enabled()) {
+    tissue["contact"]["lip_release_depth_mm"] = t.separation.lip.depth_mm;
+    tissue["contact"]["lip_release_below_mm"] = t.separation.lip.below_mm;
+    tissue["contact"]["lip_release_mode"] = lip_release_mode_name(t.separation.lip.mode);
   }
   const CannulaOptions& c = s.cannula;
   json motion = {{"accel_time_ms", s.motion.accel_time_ms}, {"speed_m_per_s", s.motion.speed_mm_per_ms}, {"travel_mm", s.motion.travel_mm},

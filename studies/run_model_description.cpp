@@ -59,6 +59,13 @@ std::string describe_run_model(const json& scene, long particles) {
       const double lead_mm = contact.value("crack_lead_mm", 0.0);
       if (lead_mm > 0) d += fmt::format(", running {:g} mm ahead of the tip", lead_mm);
     }
+    // No lip release is the default and goes unnamed; a release is said.
+    const double lip_mm = contact.value("lip_release_depth_mm", 0.0);
+    if (lip_mm > 0)
+      d += fmt::format("; the tissue the tip meets from {:g} to {:g} mm below its tip point, inside the rod's outline, is {} (lip release)",
+                       contact.value("lip_release_below_mm", 0.0), contact.value("lip_release_below_mm", 0.0) + lip_mm,
+                       contact.value("lip_release_mode", std::string("free")) == "crushed" ? "crushed: it keeps its pressure, not its shear"
+                                                                                             : "cut loose");
     // The default contact (ContactOptions: skin 0.02 mm, stiffness factor 30) goes unnamed; another is said.
     const ContactOptions default_contact;
     const double skin_mm = contact.value("skin_mm", default_contact.skin_mm);

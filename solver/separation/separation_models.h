@@ -1,6 +1,6 @@
 #pragma once
 // The separation models a scene asks for, as the list the coupled insertion applies after each step, in
-// this order: the needle's cut, the symmetry slit, the tip's crack. Each is one file implementing
+// this order: the needle's cut, the symmetry slit, the tip's crack, the lip's release. Each is one file implementing
 // SeparationModel (separation_model.h) and one line in separation_models.cpp.
 #include <Eigen/Dense>
 #include <memory>
@@ -9,18 +9,21 @@
 
 #include "solver/contact/contact_surface.h"
 #include "solver/separation/separation_model.h"
+#include "solver/separation/lip_release.h"
 #include "solver/separation/symmetry_slit.h"
 #include "solver/separation/tip_crack.h"
 
 namespace needle {
 
 // Scene keys (in the scene's tissue.contact section, where they have always been): cuts_bonds,
-// slit_half_height_mm, slit_lead_mm, crack_reach_mm, crack_angles_deg, crack_lead_mm.
+// slit_half_height_mm, slit_lead_mm, crack_reach_mm, crack_angles_deg, crack_lead_mm, lip_release_depth_mm,
+// lip_release_below_mm.
 struct SeparationOptions {
   bool needle_cut = true;   // the needle breaks the tissue bonds its body passes through (needle_bond_cut.h);
                             // false: only the tissue's failure criterion separates particles
   SymmetrySlitOptions slit;  // the tissue also opens in the symmetry plane behind the tip; off by default
   TipCrackOptions crack;     // the tip drives a crack past the rod's outline; off by default
+  LipReleaseOptions lip;     // the lip below tip point A is cut loose; off by default
   void validate(const std::string& where = "separation") const;  // InputError naming the bad field
 };
 

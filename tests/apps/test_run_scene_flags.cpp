@@ -387,3 +387,40 @@ TEST_CASE("needle run --tissue-entry-x-mm: the block starts there, the rod meets
     CHECK(std::count(out.begin(), out.end(), '\n') == 1);
   }
 }
+
+TEST_CASE("tissue.contact.lip_release_depth_mm: the scene says so, HMB's lip is cut loose and SB's is empty, bad input is refused",
+          "[apps][lspg][gmsh][lip][slow]") {
+  // HMB's tip point sits 0.80 mm above the rod's bottom: pushed 0.8 mm into the small block (0.4 mm particles) with a band
+  // 0.8 mm deep, the particles the tip passes below A inside the rod's outline are released and every bond they had is cut.
+  // SB's tip point is on the rod's bottom: the same key releases nothing and leaves its run as it was, bit for bit.
+  const std::string hmb = R"("preset": "HMB")";
+  const RunFiles kept = run_sb_into_small_block("lip_off", "", hmb);
+  const RunFiles released = run_sb_into_small_block("lip_on", "--set tissue.contact.lip_release_depth_mm=0.8", hmb);
+  CHECK_FALSE(kept.scene["tissue"]["contact"].contains("lip_release_depth_mm"));
+  CHECK(released.scene["tissue"]["contact"]["lip_release_depth_mm"].get<double>() == 0.8);
+  CHECK_FALSE(kept.summary.contains("lip_release"));
+  const nlohmann::json& lip = released.summary["lip_release"];
+  INFO("lip release " << lip.dump() << "; balance " << released.summary["energy_balance_error"]);
+  CHECK(lip["lip_thickness_mm"].get<double>() == Approx(0.80).margin(0.02));
+  CHECK(lip["particles_released"].get<long>() > 0);
+  CHECK(lip["bonds_cut"].get<long>() > 0);
+  CHECK(released.history.column("lip_particles_released").back() == lip["particles_released"].get<double>());
+  CHECK(released.summary["bonds_broken"].get<long>() >= lip["bonds_cut"].get<long>() + released.summary["bonds_cut_by_needle"].get<long>());
+  CHECK(released.summary["status"] == "finished");
+  CHECK(released.summary["energy_balance_error"].get<double>() < 0.02);
+
+  const RunFiles sb_kept = run_sb_into_small_block("lip_sb_off", "");
+  const RunFiles sb_released = run_sb_into_small_block("lip_sb_on", "--set tissue.contact.lip_release_depth_mm=0.8");
+  CHECK(sb_released.summary["lip_release"]["lip_thickness_mm"].get<double>() == Approx(0.0).margin(1e-6));
+  CHECK(sb_released.summary["lip_release"]["particles_released"].get<long>() == 0);
+  CHECK(sb_released.summary["deflection_mm"].get<double>() == sb_kept.summary["deflection_mm"].get<double>());
+
+  // A negative depth, and a needle without a tip point (the plain rod): one line, exit 2, no run folder.
+  for (const auto& [flags, message] :
+       {std::pair<std::string, std::string>{"--set tissue.contact.lip_release_depth_mm=-0.1", "lip_release_depth_mm"},
+        {"--set tissue.contact.lip_release_depth_mm=0.5", "a lip release below the tip point needs a needle with a ground tip point"}}) {
+    const std::string out = refused_on_small_block("lip_bad", flags, message);
+    INFO(flags << ": " << out);
+    CHECK(std::count(out.begin(), out.end(), '\n') == 1);
+  }
+}
