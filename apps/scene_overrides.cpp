@@ -45,6 +45,8 @@ void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
     scene.tissue.material.law = tissue_law_from_name(o.tissue_law);
     scene.tissue.material.validate();
   }
+  NEEDLE_REQUIRE(std::isnan(o.tissue_friction) || o.tissue_friction <= 2.0,
+                 fmt::format("--tissue-friction must lie in [0, 2] (a friction coefficient; the paper's 0.18; got {})", o.tissue_friction));
   if (given_or_zero(o.tissue_friction, "--tissue-friction"))
     scene.tissue.friction = scene.tissue.contact.friction = o.tissue_friction;  // as the scene key tissue.friction sets both
   if (!o.tissue_size_mm.empty()) {

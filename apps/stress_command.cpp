@@ -33,7 +33,8 @@ void run(const StressOptions& o) {
                             : std::string(NEEDLE_DATA_DIR) + (o.short_suite ? "/stress/hard_cases_short.json" : "/stress/hard_cases.json");
   NEEDLE_REQUIRE(o.suite.empty() || !o.short_suite, "give --suite or --short, not both");
   NEEDLE_REQUIRE(o.jobs >= 1 && o.jobs <= 256, fmt::format("--jobs must be from 1 to 256 (got {})", o.jobs));
-  NEEDLE_REQUIRE(o.case_time_limit_s >= 0, "--case-time-limit-s must be 0 (the default for the suite) or positive");
+  NEEDLE_REQUIRE(o.case_time_limit_s >= 0,
+                 "--case-time-limit-s must be positive, or 0 for the suite's default (900 s; 120 s with --short)");
   const SweepPlan plan = read_sweep_file(suite);
   check_sweep_cases(plan);
   const fs::path dir(o.out_dir);
@@ -67,7 +68,7 @@ void add_stress_command(CLI::App& app) {
   c->add_flag("--short", o->short_suite, "The short suite CI runs (six cases, 1 mm, seconds)");
   c->add_option("--suite", o->suite, "Another suite: a sweep file of explicit cases");
   c->add_option("--jobs", o->jobs, "Worker processes (default 2)");
-  c->add_option("--case-time-limit-s", o->case_time_limit_s, "Stop a case that runs longer and record it as timed out (default 900; short: 120)");
+  c->add_option("--case-time-limit-s", o->case_time_limit_s, "Stop a case that runs longer and record it as timed out (0: the suite's default, 900 s; 120 s with --short)");
   c->add_flag("--quiet", o->quiet, "No progress lines");
   c->callback([o] { run(*o); });
 }

@@ -255,10 +255,10 @@ class InsertionRunModel : public RunModel {
                    "a cutting pressure needs a needle with tip facets: a ground tip from a preset, d_a or a recipe (not a plain rod or a mesh file)");
     NEEDLE_REQUIRE(!scene.tissue.separation.crack.enabled() || ground_tip,
                    "a crack from the tip point needs a needle with a ground tip point: a preset, d_a or a recipe (not a plain rod or a mesh file)");
-    NEEDLE_REQUIRE(!scene.tissue.separation.lip.enabled() || ground_tip,
-                   "a lip release below the tip point needs a needle with a ground tip point: a preset, d_a or a recipe (not a plain rod or a mesh "
-                   "file)");
-    std::vector<std::unique_ptr<SeparationModel>> separations = make_separation_models(scene.tissue.separation, *surface_);
+    // A plain rod's end is cut square and a mesh file names no tip point: neither has a lip below A to release.
+    SeparationOptions separation = scene.tissue.separation;
+    if (!ground_tip) separation.lip.mode = LipReleaseMode::off;
+    std::vector<std::unique_ptr<SeparationModel>> separations = make_separation_models(separation, *surface_);
     setup_s_ = std::chrono::duration<double>(Clock::now() - start).count();
     NeedleDynamicsOptions dynamics = scene_dynamics_options(scene);
     // The implicit needle's step by default: about half the tissue's stable step at the start, a whole fraction

@@ -15,6 +15,11 @@
 namespace needle {
 namespace {
 
+// A Coulomb coefficient between steel and soft tissue or gel: 0.05-0.5 measured; above 2 no scene means it.
+ValueCheck friction_coefficient() {
+  return [](double v) { return v >= 0 && v <= 2.0 ? std::string() : std::string("must lie in [0, 2] (a friction coefficient; the paper's 0.18)"); };
+}
+
 using nlohmann::json;
 
 void read_needle(SceneObject o, NeedleScene& n, const std::string& scene_folder) {
@@ -76,7 +81,10 @@ void read_needle(SceneObject o, NeedleScene& n, const std::string& scene_folder)
 void read_motion(SceneObject o, Scene& s) {
   InsertionProfile& p = s.motion;
   p.accel_time_ms = o.quantity("accel_time", Dimension::time, p.accel_time_ms, non_negative());
-  p.speed_mm_per_ms = o.quantity("speed", Dimension::speed, p.speed_mm_per_ms, positive());
+  // Physical range: a biopsy gun fires at a few m/s (the paper's drive 8 m/s); beyond 100 m/s no scene means it.
+  p.speed_mm_per_ms = o.quantity("speed", Dimension::speed, p.speed_mm_per_ms, [](double v) {
+    return v > 0 && v <= 100.0 ? std::string() : std::string("must be positive and at most 100 m/s (the paper's drive: 8 m/s)");
+  });
   p.travel_mm = o.quantity("travel", Dimension::length, p.travel_mm, positive());
   p.decel_time_ms = o.quantity("decel_time", Dimension::time, p.decel_time_ms, non_negative());
   p.hold_ms = o.quantity("hold", Dimension::time, p.hold_ms, non_negative());
@@ -96,7 +104,7 @@ void read_cannula(SceneObject o, CannulaOptions& c) {
   c.wall_mm = o.quantity("wall", Dimension::length, c.wall_mm, positive());
   c.front_x_mm = o.quantity("front_x", Dimension::length, c.front_x_mm, any_finite());
   c.length_mm = o.quantity("length", Dimension::length, c.length_mm, positive());
-  c.friction = o.number("friction", c.friction, non_negative());
+  c.friction = o.number("friction", c.friction, friction_coefficient());
   c.penalty_scale = o.number("penalty_scale", c.penalty_scale, within(1e-6, 0.5));
   NEEDLE_REQUIRE(c.wall_mm < 0.5 * c.outer_diameter_mm, fmt::format("{}: the wall leaves no bore", o.where("wall_mm")));
   o.finish();
@@ -121,7 +129,7 @@ void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc) {
   }
   t.dilation = o.number("dilation", t.dilation, within(1.0, 4.0));
   t.spg.dilation = t.dilation;
-  t.friction = o.number("friction", t.friction, non_negative());
+  t.friction = o.number("friction", t.friction, friction_coefficient());
   t.contact.friction = t.friction;
   if (o.has("material")) t.material = material_from_json(o.raw("material"), doc.where("/tissue/material"), t.material);
   t.material.validate();
@@ -166,7 +174,7 @@ void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc) {
     t.separation.crack.reach_mm = c.quantity("crack_reach", Dimension::length, t.separation.crack.reach_mm, non_negative());
     t.separation.crack.angles_deg = c.numbers("crack_angles_deg", t.separation.crack.angles_deg, within(-180.0, 180.0));
     t.separation.crack.lead_mm = c.quantity("crack_lead", Dimension::length, t.separation.crack.lead_mm, non_negative());
-    t.separation.lip.depth_mm = c.quantity("lip_release_depth", Dimension::length, t.separation.lip.depth_mm, non_negative());
+    t.separation.lip.depth_mm = c.quantity("lip_release_depth", Dimension::length, t.separation.lip.depth_mm, positive());
     t.separation.lip.below_mm = c.quantity("lip_release_below", Dimension::length, t.separation.lip.below_mm, non_negative());
     {
       const std::string mode = c.text("lip_release_mode", lip_release_mode_name(t.separation.lip.mode));
@@ -287,11 +295,11 @@ json scene_to_json(const Scene& s) {
     tissue["contact"]["crack_angles_deg"] = t.separation.crack.angles_deg;
     tissue["contact"]["crack_lead_mm"] = t.separation.crack.lead_mm;
   }
-  if (t.separation.lip.enabled()) {
-    tissue["contact"]["lip_release_depth_mm"] = t.separation.lip.depth_mm;
-    tissue["contact"]["lip_release_below_mm"] = t.separation.lip.below_mm;
-    tissue["contact"]["lip_release_mode"] = lip_release_mode_name(t.separation.lip.mode);
-  }
+  // The lip's mode is always written (its default changed on 2026-11-27: a scene says which model made it); the
+  // band's shape only when it is not the whole lip.
+  tissue["contact"]["lip_release_mode"] = lip_release_mode_name(t.separation.lip.mode);
+  if (t.separation.lip.enabled() && t.separation.lip.below_mm != 0) tissue["contact"]["lip_release_below_mm"] = t.separation.lip.below_mm;
+  if (t.separation.lip.enabled() && std::isfinite(t.separation.lip.depth_mm)) tissue["contact"]["lip_release_depth_mm"] = t.separation.lip.depth_mm;
   const CannulaOptions& c = s.cannula;
   json motion = {{"accel_time_ms", s.motion.accel_time_ms}, {"speed_m_per_s", s.motion.speed_mm_per_ms}, {"travel_mm", s.motion.travel_mm},
                  {"direction", vector_json(s.direction)}};

@@ -62,7 +62,9 @@ struct TissueScene {
   TissueMaterial material;
   SpgOptions spg;                           // kernel, stabilization, bond failure, cfl (docs/solver.md)
   ContactOptions contact;                   // friction copied from `friction`
-  SeparationOptions separation;             // the needle's cut, slit and crack (keys in the contact section)
+  // The needle's cut, slit, crack and lip (keys in the contact section). A scene crushes the lip below a ground tip
+  // point by default (since 2026-11-27, docs/notebook/lip_release.md); the solver's own default leaves it off.
+  SeparationOptions separation = scene_separation_defaults();
   CuttingOptions cutting;                   // the cost of cutting on the tip facets (key cutting_pressure_MPa in the contact section)
 };
 

@@ -59,13 +59,19 @@ std::string describe_run_model(const json& scene, long particles) {
       const double lead_mm = contact.value("crack_lead_mm", 0.0);
       if (lead_mm > 0) d += fmt::format(", running {:g} mm ahead of the tip", lead_mm);
     }
-    // No lip release is the default and goes unnamed; a release is said.
-    const double lip_mm = contact.value("lip_release_depth_mm", 0.0);
-    if (lip_mm > 0)
-      d += fmt::format("; the tissue the tip meets from {:g} to {:g} mm below its tip point, inside the rod's outline, is {} (lip release)",
-                       contact.value("lip_release_below_mm", 0.0), contact.value("lip_release_below_mm", 0.0) + lip_mm,
-                       contact.value("lip_release_mode", std::string("free")) == "crushed" ? "crushed: it keeps its pressure, not its shear"
-                                                                                             : "cut loose");
+    // The crushed whole lip is the default and goes unnamed; another lip is said (a scene from before 2026-11-27 has no
+    // mode: the lip then stayed as the tissue is).
+    const std::string lip_mode = contact.value("lip_release_mode", std::string("off"));
+    const double lip_below_mm = contact.value("lip_release_below_mm", 0.0);
+    const bool whole_lip = lip_below_mm == 0 && !contact.contains("lip_release_depth_mm");
+    if (lip_mode == "off")
+      d += "; the lip below the tip point stays as the tissue is (no lip release)";
+    else if (lip_mode != "crushed" || !whole_lip) {
+      d += fmt::format("; the tissue the tip meets from {:g} mm below its tip point", lip_below_mm);
+      d += contact.contains("lip_release_depth_mm") ? fmt::format(" to {:g} mm", lip_below_mm + contact.value("lip_release_depth_mm", 0.0))
+                                                    : std::string(" down to the rod's bottom");
+      d += lip_mode == "free" ? ", inside the rod's outline, is cut loose (lip release free)" : ", inside the rod's outline, is crushed (lip release)";
+    }
     // The default contact (ContactOptions: skin 0.02 mm, stiffness factor 30) goes unnamed; another is said.
     const ContactOptions default_contact;
     const double skin_mm = contact.value("skin_mm", default_contact.skin_mm);

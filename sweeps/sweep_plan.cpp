@@ -45,6 +45,9 @@ VariableSpec read_variable(const JsonDocument& doc, const std::string& name, con
     for (const json& value : spec) {
       NEEDLE_REQUIRE(value.is_number() || (value.is_string() && !is_tip_variable(name)) || value.is_boolean(),
                      fmt::format("{}: '{}' values must be numbers (got {})", doc.where(pointer), name, value.dump()));
+      // The same value twice would run the same case twice (1 and 1.0 are one value).
+      NEEDLE_REQUIRE(std::none_of(v.values.begin(), v.values.end(), [&](const json& w) { return w == value; }),
+                     fmt::format("{}: '{}' lists {} twice: give each value once", doc.where(pointer), name, value.dump()));
       v.values.push_back(value);
     }
     return v;
@@ -148,6 +151,14 @@ SweepPlan read_sweep_file(const std::string& path) {
   std::vector<VariableSpec> specs;
   for (const auto& item : v.at("variables").items()) specs.push_back(read_variable(doc, item.key(), item.value(), hypercube));
   for (const VariableSpec& s : specs) {
+    // A d_a_mm variable grinds the paper's multi-bevel family: over a multi-bevel preset (LMB, AMB, HMB: the same
+    // angles) it moves A; over SB or a recipe file it would replace the base's needle in silence, so it is refused.
+    const bool multi_bevel_base = plan.base.preset == "LMB" || plan.base.preset == "AMB" || plan.base.preset == "HMB";
+    NEEDLE_REQUIRE(s.name != "d_a_mm" || multi_bevel_base || (plan.base.preset.empty() && plan.base.recipe_file.empty()),
+                   fmt::format("{}: a 'd_a_mm' variable grinds the paper's multi-bevel tips, which would replace the base's {}: leave "
+                               "that out of 'base', or give a multi-bevel base (preset LMB, AMB or HMB, or base.d_a_mm)",
+                               doc.where("/variables/d_a_mm"),
+                               plan.base.preset.empty() ? "recipe" : fmt::format("preset {}", plan.base.preset)));
     NEEDLE_REQUIRE(!plan.base.settings.contains(s.name),
                    fmt::format("{}: '{}' is both a design variable and a fixed key of 'set'", doc.where("/variables/" + json_pointer_token(s.name)), s.name));
     plan.variables.push_back(s.name);

@@ -10,17 +10,24 @@
 
 namespace needle {
 
-const char* lip_release_mode_name(LipReleaseMode mode) { return mode == LipReleaseMode::crushed ? "crushed" : "free"; }
+const char* lip_release_mode_name(LipReleaseMode mode) {
+  switch (mode) {
+    case LipReleaseMode::off: return "off";
+    case LipReleaseMode::free: return "free";
+    case LipReleaseMode::crushed: return "crushed";
+  }
+  return "?";
+}
 
 LipReleaseMode lip_release_mode_from_name(const std::string& name) {
+  if (name == "off") return LipReleaseMode::off;
   if (name == "free") return LipReleaseMode::free;
   if (name == "crushed") return LipReleaseMode::crushed;
-  throw InputError("must be free or crushed (got '" + name + "')");
+  throw InputError("must be crushed, free or off (got '" + name + "')");
 }
 
 void LipReleaseOptions::validate(const std::string& where) const {
-  NEEDLE_REQUIRE(std::isfinite(depth_mm) && depth_mm >= 0,
-                 fmt::format("{}: depth_mm must be zero (no release) or positive (got {})", where, depth_mm));
+  NEEDLE_REQUIRE(depth_mm > 0, fmt::format("{}: depth_mm must be positive (got {}; leave it out for the whole lip)", where, depth_mm));
   NEEDLE_REQUIRE(std::isfinite(below_mm) && below_mm >= 0, fmt::format("{}: below_mm must be zero or positive (got {})", where, below_mm));
 }
 
@@ -30,6 +37,13 @@ LipRelease::LipRelease(const Eigen::MatrixX3d& needle_reference_mm, const LipRel
   needle_reference_mm.col(0).maxCoeff(&tip_node_);
   tip_reference_mm_ = needle_reference_mm.row(tip_node_).transpose();
   rod_radius_mm_ = needle_reference_mm.rightCols<2>().rowwise().norm().maxCoeff();
+}
+
+double LipRelease::lip_thickness_mm(const Eigen::MatrixX3d& needle_reference_mm) {
+  NEEDLE_REQUIRE(needle_reference_mm.rows() > 0, "lip_release: the needle has no nodes");
+  Eigen::Index tip = 0;
+  needle_reference_mm.col(0).maxCoeff(&tip);
+  return needle_reference_mm(tip, 1) + needle_reference_mm.rightCols<2>().rowwise().norm().maxCoeff();
 }
 
 std::vector<std::int32_t> LipRelease::particles_in_band(const std::vector<Vec3d>& x, const Eigen::MatrixX3d& needle_x) const {
@@ -84,9 +98,9 @@ void LipRelease::apply(SpgTissue& tissue, const NeedleModel& needle) {
 }
 
 void LipRelease::add_summary(nlohmann::json& summary, const SpgTissue&) const {
-  summary["lip_release"] = {{"depth_mm", options_.depth_mm},
+  summary["lip_release"] = {{"mode", lip_release_mode_name(options_.mode)},
                             {"below_mm", options_.below_mm},
-                            {"mode", lip_release_mode_name(options_.mode)},
+                            {"depth_mm", std::isfinite(options_.depth_mm) ? nlohmann::json(options_.depth_mm) : nlohmann::json("whole lip")},
                             {"lip_thickness_mm", lip_thickness_mm()},
                             {"particles_released", released_count_},
                             {"bonds_cut", cut_},

@@ -1,33 +1,34 @@
 #pragma once
-// The thin lip below the tip point, released: the tissue the tip meets below A, inside the rod's outline and at
-// most depth_mm below A, is cut loose from everything (all its bonds are cut), so the needle's lower facets
-// push free mass points instead of pressing a layer of bonded gel into the tissue below.
+// The lip below the tip point, crushed (the default) or cut loose: the tissue a ground tip meets below its tip
+// point A, inside the rod's outline, loses its shear stiffness (crushed) or every bond (free).
 //
 // Why (docs/notebook/lip_release.md): a multi-bevel tip cuts the tissue at A, and the rod's body below A must
 // then move a lip of tissue as thick as A's height above the rod's bottom (SB 0, LMB 0.21, AMB 0.43,
-// HMB 0.80 mm). In the default model that lip stays bonded to the tissue below it and presses it down under
-// the whole shaft, which pushes the needle up; the global study found no admissible setting that flattens
-// the measured LMB -> AMB plateau. In the paper's LS-DYNA model a lip thinner than its 0.4 mm particles is
-// one particle and carries next to nothing. This model makes that a length scale of its own: the band
-// depth_mm below A is separated where the tip passes (the limit where the lip carries no load at all:
-// released particles keep their mass and momentum, and the needle's contact still acts on them, but no
-// stress). The band starts below_mm under A: below_mm = 0 releases the lip's top depth_mm (a lip thinner than
-// depth_mm whole); below_mm = l with a deep band releases whatever part of a lip is thicker than l, the limit of
-// an energy argument in which pressing a layer stores energy in proportion to its thickness while splitting it
-// off costs a fracture energy per area, so a lip thicker than a length l ~ G_c / E splits (docs/notebook/lip_release.md).
+// HMB 0.80 mm). Bonded and elastic, that lip is pressed down and presses the tissue below it under the whole
+// shaft, which pushes the needle up: calibrated on SB, LMB, AMB and HMB then ended 0.28, 1.26 and 1.07 mm above
+// the experiment, and the global study found no admissible setting that gave the measured LMB -> AMB plateau.
+// A lip squeezed between a blade's facets and the rod is crushed: the gel there is torn through its thickness
+// and flows round the rod, pushing only by its pressure.
+//
+// Modes (a scene's default is crushed, runs/scene.h; SeparationOptions{} leaves the lip off):
+// - crushed: the band's bonds stay, but its material keeps only its pressure (kParticleCrushed
+//   in SpgTissue: no shear stress, no elastic shear strain stored). It keeps the lip's volume.
+// - free: every bond of the band is cut: free mass points that the needle's contact still pushes but that carry
+//   no stress (the limit where the lip carries nothing; it over-relieves, docs/notebook/lip_release.md).
+// - off: the lip stays as the tissue is (a scene's model before 2026-11-27).
 //
 // Which particles: x within kWindowBehindMm behind A (the tip has passed them),
-// A.y - below_mm - depth_mm <= y < A.y - below_mm,
-// and inside the rod's outline, (y - axis_y)^2 + (z - axis_z)^2 <= r^2, where the rod's axis is y = z = 0 in
-// the needle's frame, moved with A's displacement, and r is the needle's largest distance from that axis.
-// Once released, a particle stays released (its bonds do not heal).
-//
-// Two ways to release (mode): free (the default above: every bond cut, a free mass point) and crushed (the bonds
-// stay, but the material there loses its shear stiffness and keeps only its pressure, kParticleCrushed in
-// SpgTissue: crushed gel that flows round the rod but still pushes where it is squeezed). Free is the limit where
-// the lip carries nothing; crushed keeps the lip's volume.
+// A.y - below_mm - depth_mm <= y < A.y - below_mm, and inside the rod's outline,
+// (y - axis_y)^2 + (z - axis_z)^2 <= r^2, where the rod's axis is y = z = 0 in the needle's frame, moved with
+// A's displacement, and r is the needle's largest distance from that axis. depth_mm is unbounded by default (the
+// whole lip, down to the rod's bottom) and below_mm 0: the two shape a band for studies (a lip's top, or its part
+// deeper than a length). Once released, a particle stays released. A tip point on the rod's bottom (SB) has no lip:
+// make_separation_models adds no model for it, and its runs are the same bit for bit whatever the mode. "Below" is the
+// needle frame's -y, the side opposite the groove and the top bevel (shared/SPEC.md's axes): a needle turned upside
+// down in its own frame is a different needle to this model.
 #include <Eigen/Dense>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -37,17 +38,20 @@
 
 namespace needle {
 
-enum class LipReleaseMode { free, crushed };
+enum class LipReleaseMode { off, free, crushed };
 const char* lip_release_mode_name(LipReleaseMode mode);
 LipReleaseMode lip_release_mode_from_name(const std::string& name);  // InputError for another name
 
 struct LipReleaseOptions {
-  double depth_mm = 0.0;  // 0: no release (the default); the band below tip point A that is cut loose
-  double below_mm = 0.0;  // the band's top lies this far below A (>= 0)
-  LipReleaseMode mode = LipReleaseMode::free;
-  bool enabled() const { return depth_mm > 0; }
+  LipReleaseMode mode = LipReleaseMode::off;
+  double below_mm = 0.0;                                         // the band's top lies this far below A (>= 0)
+  double depth_mm = std::numeric_limits<double>::infinity();  // the band's depth (> 0); unbounded: the whole lip
+  bool enabled() const { return mode != LipReleaseMode::off; }
+  bool whole_lip() const { return below_mm == 0 && depth_mm == std::numeric_limits<double>::infinity(); }
   void validate(const std::string& where = "lip_release") const;  // InputError naming the bad field
 };
+
+constexpr double kNoLipMm = 1e-6;  // a lip thinner than this is none (a tip point on the rod's bottom)
 
 class LipRelease : public SeparationModel {
  public:
@@ -67,6 +71,8 @@ class LipRelease : public SeparationModel {
   double rod_radius_mm() const { return rod_radius_mm_; }
   // The lip's thickness in the needle's frame: A's height above the rod's bottom (0 for a tip on the bottom).
   double lip_thickness_mm() const { return tip_reference_mm_.y() + rod_radius_mm_; }
+  // The same for a needle's nodes in its own frame (its most distal node the tip point).
+  static double lip_thickness_mm(const Eigen::MatrixX3d& needle_reference_mm);
   const LipReleaseOptions& options() const { return options_; }
   std::int64_t particles_released() const { return released_count_; }
   std::int64_t bonds_cut() const { return cut_; }

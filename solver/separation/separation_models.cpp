@@ -10,6 +10,12 @@ void SeparationOptions::validate(const std::string& where) const {
   lip.validate(where + ".lip_release");
 }
 
+SeparationOptions scene_separation_defaults() {
+  SeparationOptions options;
+  options.lip.mode = LipReleaseMode::crushed;
+  return options;
+}
+
 std::vector<std::unique_ptr<SeparationModel>> make_separation_models(const SeparationOptions& options, const ContactSurface& surface) {
   options.validate();
   const Eigen::MatrixX3d& needle_reference_mm = surface.reference_positions();
@@ -17,7 +23,9 @@ std::vector<std::unique_ptr<SeparationModel>> make_separation_models(const Separ
   if (options.needle_cut) models.push_back(std::make_unique<NeedleBondCut>(surface));
   if (options.slit.enabled()) models.push_back(std::make_unique<SymmetrySlit>(needle_reference_mm, options.slit));
   if (options.crack.enabled()) models.push_back(std::make_unique<TipCrack>(needle_reference_mm, options.crack));
-  if (options.lip.enabled()) models.push_back(std::make_unique<LipRelease>(needle_reference_mm, options.lip));
+  // A tip point on the rod's bottom (SB) has no lip: no model, and its run files are as they were without one.
+  if (options.lip.enabled() && LipRelease::lip_thickness_mm(needle_reference_mm) > kNoLipMm)
+    models.push_back(std::make_unique<LipRelease>(needle_reference_mm, options.lip));
   return models;
 }
 

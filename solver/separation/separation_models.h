@@ -23,9 +23,12 @@ struct SeparationOptions {
                             // false: only the tissue's failure criterion separates particles
   SymmetrySlitOptions slit;  // the tissue also opens in the symmetry plane behind the tip; off by default
   TipCrackOptions crack;     // the tip drives a crack past the rod's outline; off by default
-  LipReleaseOptions lip;     // the lip below tip point A is cut loose; off by default
+  LipReleaseOptions lip;     // the lip below tip point A crushed or cut loose; off here, crushed in a scene
   void validate(const std::string& where = "separation") const;  // InputError naming the bad field
 };
+
+// A scene's defaults: SeparationOptions{} with the lip below the tip point crushed (lip_release.h).
+SeparationOptions scene_separation_defaults();
 
 // The models options switch on, for the needle whose surface is given (they keep a reference to it).
 std::vector<std::unique_ptr<SeparationModel>> make_separation_models(const SeparationOptions& options, const ContactSurface& surface);

@@ -388,38 +388,60 @@ TEST_CASE("needle run --tissue-entry-x-mm: the block starts there, the rod meets
   }
 }
 
-TEST_CASE("tissue.contact.lip_release_depth_mm: the scene says so, HMB's lip is cut loose and SB's is empty, bad input is refused",
+TEST_CASE("tissue.contact.lip_release_mode: crushed by default, free or off on request; SB has no lip; bad input is refused",
           "[apps][lspg][gmsh][lip][slow]") {
-  // HMB's tip point sits 0.80 mm above the rod's bottom: pushed 0.8 mm into the small block (0.4 mm particles) with a band
-  // 0.8 mm deep, the particles the tip passes below A inside the rod's outline are released and every bond they had is cut.
-  // SB's tip point is on the rod's bottom: the same key releases nothing and leaves its run as it was, bit for bit.
+  // HMB's tip point sits 0.80 mm above the rod's bottom: pushed 0.8 mm into the small block (0.4 mm particles), the particles
+  // the tip passes below A inside the rod's outline are crushed by default (bonds kept), cut loose when free (every bond
+  // cut), and left as they are when off. SB's tip point is on the rod's bottom: whatever the mode, its run is the same.
   const std::string hmb = R"("preset": "HMB")";
-  const RunFiles kept = run_sb_into_small_block("lip_off", "", hmb);
-  const RunFiles released = run_sb_into_small_block("lip_on", "--set tissue.contact.lip_release_depth_mm=0.8", hmb);
-  CHECK_FALSE(kept.scene["tissue"]["contact"].contains("lip_release_depth_mm"));
-  CHECK(released.scene["tissue"]["contact"]["lip_release_depth_mm"].get<double>() == 0.8);
-  CHECK_FALSE(kept.summary.contains("lip_release"));
-  const nlohmann::json& lip = released.summary["lip_release"];
-  INFO("lip release " << lip.dump() << "; balance " << released.summary["energy_balance_error"]);
-  CHECK(lip["lip_thickness_mm"].get<double>() == Approx(0.80).margin(0.02));
-  CHECK(lip["particles_released"].get<long>() > 0);
-  CHECK(lip["bonds_cut"].get<long>() > 0);
-  CHECK(released.history.column("lip_particles_released").back() == lip["particles_released"].get<double>());
-  CHECK(released.summary["bonds_broken"].get<long>() >= lip["bonds_cut"].get<long>() + released.summary["bonds_cut_by_needle"].get<long>());
-  CHECK(released.summary["status"] == "finished");
-  CHECK(released.summary["energy_balance_error"].get<double>() < 0.02);
+  const RunFiles off = run_sb_into_small_block("lip_off", "--set tissue.contact.lip_release_mode=off", hmb);
+  const RunFiles crushed = run_sb_into_small_block("lip_crushed", "", hmb);
+  const RunFiles free_band = run_sb_into_small_block("lip_free", "--set tissue.contact.lip_release_mode=free --set tissue.contact.lip_release_depth_mm=0.8", hmb);
+  CHECK(off.scene["tissue"]["contact"]["lip_release_mode"] == "off");
+  CHECK(crushed.scene["tissue"]["contact"]["lip_release_mode"] == "crushed");
+  CHECK_FALSE(crushed.scene["tissue"]["contact"].contains("lip_release_depth_mm"));  // the whole lip
+  CHECK(free_band.scene["tissue"]["contact"]["lip_release_depth_mm"].get<double>() == 0.8);
+  CHECK_FALSE(off.summary.contains("lip_release"));
+  INFO("crushed " << crushed.summary["lip_release"].dump() << "; free " << free_band.summary["lip_release"].dump());
+  for (const RunFiles* r : {&crushed, &free_band}) {
+    const nlohmann::json& lip = r->summary["lip_release"];
+    CHECK(lip["lip_thickness_mm"].get<double>() == Approx(0.80).margin(0.02));
+    CHECK(lip["particles_released"].get<long>() > 0);
+    CHECK(r->history.column("lip_particles_released").back() == lip["particles_released"].get<double>());
+    CHECK(r->summary["status"] == "finished");
+    CHECK(r->summary["energy_balance_error"].get<double>() < 0.02);
+  }
+  CHECK(crushed.summary["lip_release"]["bonds_cut"].get<long>() == 0);
+  CHECK(crushed.summary["lip_release"]["depth_mm"] == "whole lip");
+  CHECK(free_band.summary["lip_release"]["bonds_cut"].get<long>() > 0);
+  CHECK(free_band.summary["bonds_broken"].get<long>() >=
+        free_band.summary["lip_release"]["bonds_cut"].get<long>() + free_band.summary["bonds_cut_by_needle"].get<long>());
+  CHECK(crushed.summary["deflection_mm"].get<double>() != off.summary["deflection_mm"].get<double>());
 
-  const RunFiles sb_kept = run_sb_into_small_block("lip_sb_off", "");
-  const RunFiles sb_released = run_sb_into_small_block("lip_sb_on", "--set tissue.contact.lip_release_depth_mm=0.8");
-  CHECK(sb_released.summary["lip_release"]["lip_thickness_mm"].get<double>() == Approx(0.0).margin(1e-6));
-  CHECK(sb_released.summary["lip_release"]["particles_released"].get<long>() == 0);
-  CHECK(sb_released.summary["deflection_mm"].get<double>() == sb_kept.summary["deflection_mm"].get<double>());
+  const RunFiles sb_off = run_sb_into_small_block("lip_sb_off", "--set tissue.contact.lip_release_mode=off");
+  const RunFiles sb_crushed = run_sb_into_small_block("lip_sb_crushed", "");
+  CHECK_FALSE(sb_crushed.summary.contains("lip_release"));  // no lip, no model
+  CHECK(sb_crushed.summary["deflection_mm"].get<double>() == sb_off.summary["deflection_mm"].get<double>());
+  CHECK(sb_crushed.history.column("deflection_mm") == sb_off.history.column("deflection_mm"));
 
-  // A negative depth, and a needle without a tip point (the plain rod): one line, exit 2, no run folder.
+  // A depth that is not positive, a start above A, an unknown mode: one line, exit 2, no run folder.
   for (const auto& [flags, message] :
-       {std::pair<std::string, std::string>{"--set tissue.contact.lip_release_depth_mm=-0.1", "lip_release_depth_mm"},
-        {"--set tissue.contact.lip_release_depth_mm=0.5", "a lip release below the tip point needs a needle with a ground tip point"}}) {
+       {std::pair<std::string, std::string>{"--set tissue.contact.lip_release_depth_mm=0", "lip_release_depth_mm"},
+        {"--set tissue.contact.lip_release_below_mm=-0.1", "lip_release_below_mm"},
+        {"--set tissue.contact.lip_release_mode=dissolved", "must be crushed, free or off (got 'dissolved')"}}) {
     const std::string out = refused_on_small_block("lip_bad", flags, message);
+    INFO(flags << ": " << out);
+    CHECK(std::count(out.begin(), out.end(), '\n') == 1);
+  }
+}
+
+TEST_CASE("needle run refuses an absurd friction or drive speed by its flag, as the scene key does (issue 51)", "[apps][scene]") {
+  for (const auto& [flags, message] :
+       {std::pair<std::string, std::string>{"--tissue-friction 1e308", "--tissue-friction must lie in [0, 2]"},
+        {"--speed-m-per-s 1e308", "--speed-m-per-s: insertion speed 1e+308 m/s is beyond any biopsy device (at most 100 m/s)"},
+        {"--set tissue.friction=5", "must lie in [0, 2]"},
+        {"--set motion.speed_m_per_s=500", "at most 100 m/s"}}) {
+    const std::string out = refused_on_small_block("physical_bad", flags, message);
     INFO(flags << ": " << out);
     CHECK(std::count(out.begin(), out.end(), '\n') == 1);
   }

@@ -53,6 +53,14 @@ TEST_CASE("apply_scene_settings sets dotted keys with units, replaces a key's ot
   CHECK(refusal("motion.travel=3").find("--set motion.travel=3: motion.travel") == 0);  // a bare number where a unit is needed
   CHECK(refusal("tissue.material.nu=0.7").find("--set tissue.material.nu=0.7: tissue nu must lie in (-1, 0.5) (got 0.7)") == 0);
   CHECK(refusal("tissue.material.E_MPa") == "--set tissue.material.E_MPa: give key=value, e.g. --set tissue.material.E_MPa=0.1");
+  // Physical ranges (issue 51): an absurd friction or drive speed is refused by the key that has it, not run or blamed elsewhere.
+  CHECK(refusal("tissue.friction=1e308").find("tissue.friction") != std::string::npos);
+  CHECK(refusal("tissue.friction=1e308").find("must lie in [0, 2]") != std::string::npos);
+  CHECK(refusal("cannula.friction=3").find("must lie in [0, 2]") != std::string::npos);
+  CHECK(refusal("motion.speed_m_per_s=1e308").find("motion.speed") != std::string::npos);
+  CHECK(refusal("motion.speed_m_per_s=1e308").find("at most 100 m/s") != std::string::npos);
+  CHECK(refusal("motion.speed_m_per_s=4") == "accepted");
+  CHECK(refusal("tissue.friction=0.4") == "accepted");
   CHECK(refusal("tissue..nu=1").find("is not a dotted scene key") != std::string::npos);
   CHECK(refusal("needle.length_mm.x=1").find("length_mm is a value, not a section") != std::string::npos);
 }

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "solver/separation/lip_release.h"
+#include "solver/separation/separation_models.h"
 #include "tests/solver/solver_fixtures.h"
 
 using namespace needle;
@@ -34,7 +35,8 @@ TEST_CASE("The lip release takes the particles below tip point A, inside the rod
   const std::vector<Vec3d> x = lattice();
   // A at y = -0.05: a lip 0.45 mm thick (AMB's is 0.43). Window x in [0.55, 1.05]: columns 0.6, 0.8, 1.0.
   const Eigen::MatrixX3d needle = needle_with_tip({1.05, -0.05, 0.0});
-  LipReleaseOptions options;
+  LipReleaseOptions options;  // crushed or free select alike
+  options.mode = LipReleaseMode::crushed;
   options.depth_mm = 0.45;
   const LipRelease lip(needle, options);
   CHECK(lip.rod_radius_mm() == Approx(0.5));
@@ -58,6 +60,11 @@ TEST_CASE("The lip release takes the particles below tip point A, inside the rod
   SECTION("a deeper band takes no more than the lip: below the rod's bottom nothing is released") {
     options.depth_mm = 2.0;
     CHECK(LipRelease(needle, options).particles_in_band(x, needle).size() == 15);
+    LipReleaseOptions whole;  // the band's default: the whole lip
+    whole.mode = LipReleaseMode::crushed;
+    CHECK(whole.whole_lip());
+    CHECK(LipRelease(needle, whole).particles_in_band(x, needle).size() == 15);
+    CHECK(LipRelease::lip_thickness_mm(needle) == Approx(0.45));
   }
   SECTION("a band that starts below A takes the lip's deeper part: a lip thinner than where it starts keeps everything") {
     options.below_mm = 0.25;  // y in [-1.30, -0.30): the layer -0.35 only (2 z a column)
@@ -82,8 +89,10 @@ TEST_CASE("The lip release takes the particles below tip point A, inside the rod
     CHECK(up.size() == 15);
     for (const std::int32_t i : up) CHECK(x[static_cast<size_t>(i)].y() > -0.2);
   }
-  SECTION("no depth, no release") {
-    options.depth_mm = 0;
+  SECTION("off, no release: the solver's default, while a scene's default crushes") {
+    CHECK(LipReleaseOptions{}.mode == LipReleaseMode::off);
+    CHECK(scene_separation_defaults().lip.mode == LipReleaseMode::crushed);
+    options.mode = LipReleaseMode::off;
     CHECK(LipRelease(needle, options).particles_in_band(x, needle).empty());
   }
 }
@@ -104,6 +113,7 @@ TEST_CASE("Released particles lose every bond and carry no stress; mass and the 
   const Eigen::MatrixX3d needle = needle_with_tip({1.05, 0.05, 0.0});
   LipReleaseOptions options;
   options.depth_mm = 0.4;
+  options.mode = LipReleaseMode::free;
   LipRelease lip(needle, options);
   const std::vector<std::int32_t> band = lip.particles_in_band(p.position_mm, needle);
   REQUIRE_FALSE(band.empty());
@@ -140,9 +150,11 @@ TEST_CASE("Released particles lose every bond and carry no stress; mass and the 
 TEST_CASE("The lip release's options refuse unphysical values with the field's name", "[solver][lip]") {
   LipReleaseOptions o;
   o.depth_mm = -0.1;
-  CHECK_THROWS_WITH(o.validate("tissue.contact"), Catch::Contains("tissue.contact: depth_mm must be zero (no release) or positive"));
+  CHECK_THROWS_WITH(o.validate("tissue.contact"), Catch::Contains("tissue.contact: depth_mm must be positive"));
+  o.depth_mm = 0;
+  CHECK_THROWS_WITH(o.validate(), Catch::Contains("depth_mm must be positive"));
   o.depth_mm = std::nan("");
-  CHECK_THROWS_WITH(o.validate(), Catch::Contains("depth_mm must be zero (no release) or positive"));
+  CHECK_THROWS_WITH(o.validate(), Catch::Contains("depth_mm must be positive"));
   o.depth_mm = 0.3;
   o.below_mm = -1;
   CHECK_THROWS_WITH(o.validate(), Catch::Contains("below_mm must be zero or positive"));
@@ -226,5 +238,7 @@ TEST_CASE("The crushed lip keeps its bonds and its particles as integration poin
   CHECK(crushed == static_cast<std::int64_t>(band.size()));
   for (const std::int32_t i : band) CHECK(tissue.is_integration_point(i));
   CHECK(lip_release_mode_from_name(lip_release_mode_name(LipReleaseMode::crushed)) == LipReleaseMode::crushed);
-  CHECK_THROWS_WITH(lip_release_mode_from_name("dissolved"), Catch::Contains("must be free or crushed (got 'dissolved')"));
+  CHECK_THROWS_WITH(lip_release_mode_from_name("dissolved"), Catch::Contains("must be crushed, free or off (got 'dissolved')"));
+  for (const LipReleaseMode m : {LipReleaseMode::off, LipReleaseMode::free, LipReleaseMode::crushed})
+    CHECK(lip_release_mode_from_name(lip_release_mode_name(m)) == m);
 }

@@ -32,7 +32,8 @@ void write_run(const fs::path& dir, const std::string& name, const FakeRun& r) {
                         {"particles_inside", 0}, {"bonds_broken", 100}, {"bonds_cut_by_needle", 80}, {"particles", 48843},
                         {"groove", {{"groove_fill", r.groove_fill}, {"floor_contact_fraction", r.groove_fill / 2}, {"mean_gap_mm", 0.1}}}};
   std::ofstream(folder / "summary.json") << summary.dump(2);
-  const json scene = {{"tissue", {{"spacing_mm", 0.4}, {"path_refinement", 2}, {"path_half_width_mm", 1.2}, {"contact", {{"cuts_bonds", true}}}}}};
+  const json scene = {{"tissue", {{"spacing_mm", 0.4}, {"path_refinement", 2}, {"path_half_width_mm", 1.2},
+                                  {"contact", {{"cuts_bonds", true}, {"lip_release_mode", "crushed"}}}}}};
   std::ofstream(folder / "scene.json") << scene.dump(2);
   std::ofstream history(folder / "history.csv");
   history << "time_ms,insertion_mm,deflection_mm\n";
@@ -154,7 +155,8 @@ TEST_CASE("needle paper --report-only names the tissue law, the relaxation, the 
                           {"size_mm", {40.0, 16.0, 6.0}},
                           {"entry_x_mm", 0.1},
                           {"contact", {{"cuts_bonds", true}, {"slit_half_height_mm", 1.0}, {"crack_reach_mm", 1.2},
-                                       {"crack_angles_deg", {0.0, -45.0}}, {"crack_lead_mm", 0.5}, {"cutting_pressure_MPa", 0.3}, {"skin_mm", 0.04},
+                                       {"crack_angles_deg", {0.0, -45.0}}, {"crack_lead_mm", 0.5}, {"lip_release_mode", "free"},
+                                       {"lip_release_below_mm", 0.1}, {"lip_release_depth_mm", 0.3}, {"cutting_pressure_MPa", 0.3}, {"skin_mm", 0.04},
                                        {"stiffness_factor", 10.0}, {"law", "projection"}}},
                           {"material", {{"law", "stiffening_elastic"}, {"relaxing_shear_fraction", 0.5}, {"relaxation_time_ms", 0.2}}},
                           {"spg", {{"support", "ellipsoid"}}}}},
@@ -172,6 +174,8 @@ TEST_CASE("needle paper --report-only names the tissue law, the relaxation, the 
                                           "the tissue also splits in the symmetry plane behind the tip, 1 mm either side of the rod's axis; "
                                           "the tip drives a crack past the rod: fins from the tip point at 0, -45 deg in the cross-section "
                                           "(0: horizontal), 1.2 mm long, running 0.5 mm ahead of the tip; "
+                                          "the tissue the tip meets from 0.1 mm below its tip point to 0.4 mm, inside the rod's outline, is cut loose "
+                                          "(lip release free); "
                                           "the contact's skin is 0.04 mm and its stiffness factor 10 (the defaults: 0.02 and 30); "
                                           "the implicit linear needle and the kinematic (projection) contact, the tissue mass-scaled to the "
                                           "needle's step, ellipsoidal kernel supports (--model fast); "
@@ -451,4 +455,19 @@ TEST_CASE("needle paper sets the paper's other observations beside the runs' str
     REQUIRE(results.contains("observations"));
     CHECK(results["observations"].size() == 17);
   }
+}
+
+TEST_CASE("needle paper --report-only says when its runs kept the lip below the tip point (runs from before the crushed lip)",
+          "[apps][paper][slow]") {
+  const fs::path dir = fresh("lip_off");
+  for (const char* name : {"SB", "LMB", "AMB", "HMB"}) {
+    write_run(dir, name, {-1.1, 0.9});
+    const json scene = {{"tissue", {{"spacing_mm", 0.4}, {"path_refinement", 2}, {"path_half_width_mm", 1.2}, {"contact", {{"cuts_bonds", true}}}}}};
+    std::ofstream(dir / "runs" / name / "scene.json") << scene.dump(2);
+  }
+  const auto result = run("paper --report-only --no-tips --quiet --out " + dir.string(), true);
+  INFO(result.out);
+  REQUIRE(result.exit_code == 0);
+  CHECK(read_text(dir / "report.md").find("the needle cuts the bonds its body passes through; the lip below the tip point stays as the tissue "
+                                          "is (no lip release)") != std::string::npos);
 }

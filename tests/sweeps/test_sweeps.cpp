@@ -294,6 +294,11 @@ TEST_CASE("Bad sweep and optimisation files get one clear error before any case 
       {R"({"base": {"scene": "scene.json"}, "variables": {"tissue.colour": [1, 2]}})", "colour"},
       {R"({"base": {"scene": "scene.json"}, "design": {"latin_hypercube": {"samples": 4}}, "variables": {"d_a_mm": [0, 0.1]}})",
        "a Latin hypercube samples ranges"},
+      // The same value twice would run one case twice; a d_a_mm variable would replace a base preset in silence (issue 51).
+      {R"({"base": {"scene": "scene.json"}, "variables": {"d_a_mm": [0, 0.1, 0.0]}})", "'d_a_mm' lists 0.0 twice: give each value once"},
+      {R"({"base": {"scene": "scene.json"}, "variables": {"tissue.friction": [0.1, 0.2, 0.1]}})", "'tissue.friction' lists 0.1 twice"},
+      {R"({"base": {"scene": "scene.json", "preset": "SB"}, "variables": {"d_a_mm": [0, 0.1]}})",
+       "a 'd_a_mm' variable grinds the paper's multi-bevel tips, which would replace the base's preset SB"},
   };
   for (const auto& [text, message] : sweeps) {
     write(dir / "bad.json", text);
@@ -315,6 +320,16 @@ TEST_CASE("Bad sweep and optimisation files get one clear error before any case 
       {R"({"base": {"scene": "scene.json"}, "variables": {"d_a_mm": {"min": -0.3, "max": 0.3, "start": 0.5}}, "objective": {"deflection_target_mm": 0}})",
        "outside"},
   };
+  {
+    // The refusal of a negative time limit and --help name the same defaults (issue 51).
+    const Result bad = run("stress --short --case-time-limit-s -1 --out " + (dir / "out").string(), true);
+    const Result help = run("stress --help", true);
+    INFO(bad.out << "\n" << help.out);
+    CHECK(bad.exit_code == 2);
+    CHECK(bad.out.find("0 for the suite's default (900 s; 120 s with --short)") != std::string::npos);
+    CHECK(help.out.find("0: the suite's default, 900 s; 120 s with --short") != std::string::npos);
+    CHECK(!fs::exists(dir / "out"));
+  }
   for (const auto& [text, message] : searches) {
     write(dir / "bad_search.json", text);
     const Result r = run("optimize " + (dir / "bad_search.json").string() + " --out " + (dir / "out").string(), true);

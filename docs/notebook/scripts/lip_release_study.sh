@@ -8,7 +8,7 @@
 #   docs/notebook/scripts/lip_release_study.sh [OUT] [BELOW_MM,DEPTH_MM...]
 #       default: out/lip_release, cases 0,0.45 0,0.2 (the lip's top released) and 0.2,1 0.3,1 (a lip's part
 #       deeper than 0.2 or 0.3 mm released); NEEDLES="LMB AMB HMB" (SB's tip point is on the rod's bottom: it has
-#       no lip, and the release leaves it as it is; NEEDLES="SB" checks that); MODE=crushed (default free)
+#       no lip, and the release leaves it as it is; NEEDLES="SB" checks that); MODE=crushed or off (default free)
 #       keeps the band's bonds and takes its shear stiffness (tissue.contact.lip_release_mode); a replica:
 #       TAG=x0.1 EXTRA="--set tissue.entry_x_mm=0.1" (the lattice shifted; TAG names its folders and table)
 #
@@ -24,7 +24,7 @@ cases=("$@")
 [ "${#cases[@]}" -gt 0 ] || cases=(0,0.45 0,0.2 0.2,1 0.3,1)
 read -r -a needles <<< "${NEEDLES:-LMB AMB HMB}"
 mode="${MODE:-free}"
-[[ "$mode" == free || "$mode" == crushed ]] || { echo "lip_release_study: MODE='$mode' is not free or crushed" >&2; exit 2; }
+[[ "$mode" == free || "$mode" == crushed || "$mode" == off ]] || { echo "lip_release_study: MODE='$mode' is not free, crushed or off" >&2; exit 2; }
 suffix=""
 [ "$mode" = free ] || suffix="_$mode"
 [ -z "${TAG:-}" ] || suffix="${suffix}_$TAG"
