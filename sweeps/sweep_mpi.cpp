@@ -1,5 +1,7 @@
 #include "sweeps/sweep_mpi.h"
 
+#include <algorithm>
+
 #include <chrono>
 #include <cstdlib>
 #include <fmt/format.h>
@@ -52,13 +54,15 @@ CaseResult run_case_here(const SweepPlan& plan, const SweepCase& c, const fs::pa
 
 void dispatch(const MpiSession& mpi, const SweepPlan& plan, const fs::path& dir, int threads, bool quiet) {
   const std::vector<SweepCase> todo = cases_to_run(plan, dir);
-  SweepProgress progress(static_cast<int>(plan.cases.size()), static_cast<int>(plan.cases.size() - todo.size()), mpi.size() - 1, quiet);
+  SweepProgress progress(static_cast<int>(plan.cases.size()), static_cast<int>(plan.cases.size() - todo.size()), std::max(1, mpi.size() - 1),
+                         quiet);  // one rank alone runs the cases itself
   InterruptWatch watch;
   if (mpi.size() == 1) {  // no worker rank: run them here
     for (const SweepCase& c : todo) {
       progress.case_started(c.name, describe_case(c.label, c.values));
       const double start = now_s();
-      progress.case_done(run_case_here(plan, c, dir, threads), now_s() - start);
+      const CaseResult result = run_case_here(plan, c, dir, threads);  // before the clock is read again
+      progress.case_done(result, now_s() - start);
     }
     return;
   }

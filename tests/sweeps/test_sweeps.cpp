@@ -3,6 +3,7 @@
 // on worker processes, on MPI ranks and as a batch array with the same table, a sweep interrupted and started again,
 // bad files refused before anything runs, and `needle optimize` with its best tip read back by `needle tip`.
 #include <catch2/catch.hpp>
+#include <regex>
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
@@ -170,6 +171,26 @@ TEST_CASE("needle sweep gives one table on worker processes, on MPI ranks and as
   CHECK(mpi.find("exit=0") != std::string::npos);
   CHECK(mpi.find("on 2 MPI ranks") != std::string::npos);
   CHECK(deflections(dir / "mpi") == reference);  // bit for bit
+
+  // One rank alone runs the cases itself, and says how long each took (issue 51: it said 0 s for cases of 1.4 s).
+  const std::string mpi1 = stderr_of("mpirun --allow-run-as-root --oversubscribe -n 1 " + std::string(NEEDLE_BINARY) + " sweep " + sweep + " --out " +
+                                     (dir / "mpi1").string() + "; echo exit=$?");
+  INFO(mpi1);
+  CHECK(mpi1.find("exit=0") != std::string::npos);
+  CHECK(deflections(dir / "mpi1") == reference);
+  {
+    const std::regex line("sweep: (case_[0-9]+) finished in ([0-9]+) s");
+    int timed = 0;
+    for (auto it = std::sregex_iterator(mpi1.begin(), mpi1.end(), line); it != std::sregex_iterator(); ++it) {
+      std::ifstream in(dir / "mpi1" / "cases" / (*it)[1].str() / "run" / "summary.json");
+      REQUIRE(in.good());
+      const double runtime_s = nlohmann::json::parse(in)["runtime_s"].get<double>();
+      INFO((*it)[0].str() << "; the run's own runtime " << runtime_s << " s");
+      CHECK(std::stod((*it)[2].str()) + 0.5 >= runtime_s);  // the case's wall time holds its run's
+      ++timed;
+    }
+    CHECK(timed == 4);
+  }
 
   // A batch array: one case a task (SLURM_ARRAY_TASK_ID), then --collect.
   const Result count = run("sweep " + sweep + " --count");
