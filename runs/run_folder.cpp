@@ -65,6 +65,7 @@ RunFolder::RunFolder(const std::string& dir, bool overwrite) : final_(dir), over
   namespace fs = std::filesystem;
   const CheckedTarget checked = checked_target(dir, overwrite);
   final_ = fs::path(dir).has_filename() ? fs::path(dir) : checked.target;  // "runs/SB/": the folder runs/SB
+  lock_ = std::make_unique<WriterLock>(checked.target, dir);  // a second writer stops here, before it removes the first's partial
   partial_ = checked.parent / ("." + checked.target.filename().string() + ".partial");
   fs::remove_all(partial_);
   fs::create_directories(partial_);

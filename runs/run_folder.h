@@ -2,12 +2,16 @@
 // A simulation's output folder. Everything is written into a hidden sibling "DIR.partial" first; the
 // folder appears under its own name when the run ends (finished, or stopped by the solver with what
 // it wrote so far), and is removed if the run fails on bad input. An existing DIR is refused unless
-// overwriting is asked for, and then replaced only when the new run has ended.
+// overwriting is asked for, and then replaced only when the new run has ended. One writer at a time: a second
+// run on the same DIR while the first writes is refused with the first's pid (writer_lock.h), and touches nothing.
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "runs/writer_lock.h"
 
 namespace needle {
 
@@ -28,6 +32,7 @@ class RunFolder {
   const std::filesystem::path& final_path() const { return final_; }
 
  private:
+  std::unique_ptr<WriterLock> lock_;  // taken before the partial folder is touched, held until this is destroyed
   std::filesystem::path final_, partial_;
   bool overwrite_ = false, committed_ = false;
 };

@@ -404,3 +404,35 @@ TEST_CASE("Ctrl-C during a run writes what there is, marked interrupted, exits 1
   CHECK(needle::read_csv_table((out / "history.csv").string()).rows.size() >= 2);
   for (const auto& entry : fs::directory_iterator(dir)) CHECK(entry.path().filename().string().find("partial") == std::string::npos);
 }
+
+TEST_CASE("Two writers on one run folder: the second is refused with the first's pid, and the first's run is complete", "[apps][sim][lock][slow]") {
+  // The first run (sb_quick: about 15 s) is under way, writing its partial folder; the second, on the same --out, must
+  // stop with one line and exit 2 without touching it (issue 51: it used to delete it, and the first lost its results).
+  const fs::path dir = fresh_folder("two_writers");
+  const fs::path out = dir / "run", partial = dir / ".run.partial" / "history.csv";
+  const std::string command = fmt::format(
+      "{0} simulate {1}/data/scenes/sb_quick.json --out {2} --quiet > {3}/first.log 2>&1 & pid=$!; "
+      "for i in $(seq 600); do [ -s {4} ] && break; sleep 0.05; done; "
+      "{0} simulate {1}/data/scenes/sb_quick.json --out {2} --quiet 2>&1; echo \"second exit $? first pid $pid\"; "
+      "wait $pid; echo \"first exit $?\"",
+      NEEDLE_BINARY, NEEDLE_SOURCE_DIR, out.string(), dir.string(), partial.string());
+  FILE* pipe = popen(command.c_str(), "r");
+  REQUIRE(pipe);
+  std::string text;
+  char buffer[4096];
+  size_t n;
+  while ((n = fread(buffer, 1, sizeof buffer, pipe)) > 0) text.append(buffer, n);
+  pclose(pipe);
+  INFO(text);
+  const auto pid_at = text.find("first pid ");
+  REQUIRE(pid_at != std::string::npos);
+  const std::string pid = text.substr(pid_at + 10, text.find('\n', pid_at) - pid_at - 10);
+  CHECK(text.find("is being written by another needle (pid " + pid + ")") != std::string::npos);
+  CHECK(text.find("second exit 2") != std::string::npos);
+  CHECK(text.find("first exit 0") != std::string::npos);
+  REQUIRE(fs::exists(out / "summary.json"));
+  std::ifstream summary_file(out / "summary.json");
+  CHECK(nlohmann::json::parse(summary_file)["status"] == "finished");
+  for (const auto& entry : fs::directory_iterator(dir)) CHECK(entry.path().filename().string().find("partial") == std::string::npos);
+  CHECK_FALSE(fs::exists(dir / ".run.lock"));
+}
