@@ -22,9 +22,6 @@ struct OptimizeOptions {
 void run(const OptimizeOptions& o) {
   const OptimizationProblem problem = read_optimization_file(o.file);
   const int threads = o.threads > 0 ? o.threads : hardware_threads();
-  if (!o.quiet)
-    fmt::print(stderr, "optimize: {} over {} variable(s), at most {} evaluations, into {}\n", problem.method, problem.variables.size(),
-               problem.max_evaluations, o.out_dir);
   const OptimizationOutcome outcome = optimize_design(problem, o.out_dir, threads, o.quiet);
   fmt::print("optimize: {} evaluations; stopped: {}\n", outcome.evaluations.size(), outcome.stop_reason);
   if (outcome.best < 0) {

@@ -153,6 +153,10 @@ OptimizationProblem read_optimization_file(const std::string& path) {
 
 OptimizationOutcome optimize_design(const OptimizationProblem& p, const fs::path& dir, int threads, bool quiet) {
   claim_study_folder(dir, "optimize_plan.json", problem_to_json(p));
+  // Only once the folder is claimed: an --out that cannot be used gets its one line and nothing before it.
+  if (!quiet)
+    fmt::print(stderr, "optimize: {} over {} variable(s), at most {} evaluations, into {}\n", p.method, p.variables.size(), p.max_evaluations,
+               dir.string());
   const size_t n = p.variables.size();
   OptimizationOutcome outcome;
   std::map<std::string, size_t> seen;  // the values' JSON -> evaluation

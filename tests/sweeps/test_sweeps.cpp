@@ -342,6 +342,17 @@ TEST_CASE("Bad sweep and optimisation files get one clear error before any case 
        "outside"},
   };
   {
+    // An --out that is a file: one line, no progress line before it (issue 51).
+    write(dir / "good_search.json", R"({"base": {"scene": "scene.json"}, "variables": {"d_a_mm": {"min": -0.3, "max": 0.3}}, )"
+                                    R"("objective": {"deflection_target_mm": 0}})");
+    write(dir / "a_file", "x");
+    const Result r = run("optimize " + (dir / "good_search.json").string() + " --out " + (dir / "a_file").string(), true);
+    INFO(r.out);
+    CHECK(r.exit_code == 2);
+    CHECK(r.out.find("exists and is not a folder") != std::string::npos);
+    CHECK(std::count(r.out.begin(), r.out.end(), '\n') == 1);
+  }
+  {
     // The refusal of a negative time limit and --help name the same defaults (issue 51).
     const Result bad = run("stress --short --case-time-limit-s -1 --out " + (dir / "out").string(), true);
     const Result help = run("stress --help", true);
