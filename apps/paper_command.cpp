@@ -13,6 +13,7 @@
 
 #include "apps/cli_checks.h"
 #include "runs/insertion_run.h"
+#include "runs/model_levels.h"
 #include "apps/scene_overrides.h"
 #include "runs/json_file.h"
 #include "studies/paper_report.h"
@@ -68,8 +69,20 @@ void paper(const PaperOptions& o) {
     scene.tissue.material.E_MPa = o.tissue_E_MPa;
     E_source = "given with --tissue-E-MPa";
   }
+  // Without --calibration or --tissue-E-MPa, the runs take the shipped SB calibration of their model level, as
+  // `needle run` does (issue 49: the card's E 0.665 MPa put SB at -4.19 mm); --report-only reads E from the runs.
+  std::string calibration_file = o.calibration_file;
+  if (calibration_file.empty() && std::isnan(o.tissue_E_MPa) && !o.report_only) {
+    Scene probe = scene;
+    apply_scene_overrides(probe, o.overrides);
+    calibration_file = default_calibration_file(model_level_of(probe));
+    scene.tissue.material.E_MPa = calibrated_E(calibration_file);
+    E_source = fmt::format("calibrated on SB: {} (the shipped calibration of the model level)", calibration_file);
+  }
   scene.tissue.material.validate();
+  const double E_before = scene.tissue.material.E_MPa;
   apply_scene_overrides(scene, o.overrides);
+  if (scene.tissue.material.E_MPa != E_before) E_source = "given with --set";
   std::vector<ComparedModel> compare, replicas;
   for (const auto& [texts, flag, models] : {std::tuple{&o.compare, "--compare", &compare}, std::tuple{&o.replicas, "--replica", &replicas}})
     for (const std::string& c : *texts) {
@@ -135,7 +148,7 @@ void paper(const PaperOptions& o) {
   report.reference_path = o.reference;
   report.tissue_E_MPa = scene.tissue.material.E_MPa;
   report.tissue_E_source = E_source;
-  report.calibration_path = o.calibration_file;
+  report.calibration_path = calibration_file;
   report.command_line = o.command_line;
   report.draw_tips = !o.no_tips;
   report.compare = compare;
@@ -154,7 +167,9 @@ void add_paper_command(CLI::App& app) {
   c->add_option("--out", o->out_dir, "Report folder (created; runs go to OUT/runs/NAME)")->required();
   c->add_option("--needles", o->needles, "Comma-separated needles (default SB,LMB,AMB,HMB)");
   c->add_option("--tissue-E-MPa", o->tissue_E_MPa, "Tissue Young's modulus (default: the card's 0.665 MPa)");
-  c->add_option("--calibration", o->calibration_file, "calibration.json from `needle calibrate` (its tissue_E_MPa)");
+  c->add_option("--calibration", o->calibration_file,
+                "calibration.json from `needle calibrate` (its tissue_E_MPa; default: the shipped SB calibration of the model level, "
+                "data/paper/calibration_sb.json for the default)");
   c->add_option("--reference", o->reference, "The paper's reference table (default data/paper/reference.json)");
   add_scene_override_options(c, o->overrides);
   c->add_option("--mesh-size-mm", o->overrides.mesh_size_mm, "Needle mesh size (run default 0.4)");

@@ -471,3 +471,18 @@ TEST_CASE("needle paper --report-only says when its runs kept the lip below the 
   CHECK(read_text(dir / "report.md").find("the needle cuts the bonds its body passes through; the lip below the tip point stays as the tissue "
                                           "is (no lip release)") != std::string::npos);
 }
+
+TEST_CASE("needle paper without --calibration takes the shipped SB calibration, as needle run does", "[apps][paper][slow]") {
+  // Issue 49: it used to run at the card's E 0.665 MPa (SB -4.19 mm). A short SB run on a small block is enough to see
+  // which E the run took and what the report says of it.
+  const fs::path dir = fresh("default_E");
+  const auto r = run("paper --needles SB --set motion.accel_time_ms=0.02 --set motion.travel_mm=0.8 --tissue-size-mm 2,2.4,1.2 --spacing-mm 0.4 --path-refinement 1 --mesh-size-mm 0.5 --no-tips --quiet --out " +
+                         dir.string(),
+                     true);
+  INFO(r.out);
+  REQUIRE(r.exit_code == 0);
+  const json scene = read_json(dir / "runs" / "SB" / "scene.json");
+  const json calibration = read_json(fs::path(NEEDLE_SOURCE_DIR) / "data" / "paper" / "calibration_sb.json");
+  CHECK(scene["tissue"]["material"]["E_MPa"].get<double>() == calibration["tissue_E_MPa"].get<double>());
+  CHECK(read_text(dir / "report.md").find("(the shipped calibration of the model level)") != std::string::npos);
+}
