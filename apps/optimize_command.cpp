@@ -16,13 +16,13 @@ namespace {
 struct OptimizeOptions {
   std::string file, out_dir;
   int threads = 0;
-  bool quiet = false;
+  bool quiet = false, allow_other_code = false;
 };
 
 void run(const OptimizeOptions& o) {
   const OptimizationProblem problem = read_optimization_file(o.file);
   const int threads = o.threads > 0 ? o.threads : hardware_threads();
-  const OptimizationOutcome outcome = optimize_design(problem, o.out_dir, threads, o.quiet);
+  const OptimizationOutcome outcome = optimize_design(problem, o.out_dir, threads, o.quiet, o.allow_other_code);
   fmt::print("optimize: {} evaluations; stopped: {}\n", outcome.evaluations.size(), outcome.stop_reason);
   if (outcome.best < 0) {
     fmt::print("optimize: no evaluation finished\n");
@@ -46,6 +46,8 @@ void add_optimize_command(CLI::App& app) {
   c->add_option("--out", o->out_dir, "The search's folder (created; a folder of the same search goes on where it stopped)")->required();
   c->add_option("--threads", o->threads, "Worker threads of each evaluation (default: all cores)")->check(count_check());
   c->add_flag("--quiet", o->quiet, "No progress lines");
+  c->add_flag("--allow-other-code", o->allow_other_code,
+              "Go on with a study whose cases another build of needle began (its study_code.txt names it): one table then mixes two codes' results");
   c->callback([o] { run(*o); });
 }
 

@@ -23,7 +23,7 @@ namespace {
 
 struct StressOptions {
   std::string out_dir, suite;
-  bool short_suite = false, quiet = false;
+  bool short_suite = false, quiet = false, allow_other_code = false;
   int jobs = 2;
   double case_time_limit_s = 0;
 };
@@ -38,7 +38,7 @@ void run(const StressOptions& o) {
   const SweepPlan plan = read_sweep_file(suite);
   check_sweep_cases(plan);
   const fs::path dir(o.out_dir);
-  claim_study_folder(dir, "sweep_plan.json", sweep_plan_to_json(plan));
+  claim_study_folder(dir, "sweep_plan.json", sweep_plan_to_json(plan), o.allow_other_code);
   SweepWorkers workers;
   workers.sweep_file = fs::absolute(suite).string();
   workers.jobs = o.jobs;
@@ -70,6 +70,8 @@ void add_stress_command(CLI::App& app) {
   c->add_option("--jobs", o->jobs, "Worker processes (default 2)");
   c->add_option("--case-time-limit-s", o->case_time_limit_s, "Stop a case that runs longer and record it as timed out (0: the suite's default, 900 s; 120 s with --short)");
   c->add_flag("--quiet", o->quiet, "No progress lines");
+  c->add_flag("--allow-other-code", o->allow_other_code,
+              "Go on with a study whose cases another build of needle began (its study_code.txt names it): one table then mixes two codes' results");
   c->callback([o] { run(*o); });
 }
 

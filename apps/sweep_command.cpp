@@ -26,7 +26,7 @@ namespace {
 struct SweepOptions {
   std::string file, out_dir;
   int jobs = 1, threads = 0, task_index = -1;
-  bool collect = false, count = false, quiet = false;
+  bool collect = false, count = false, quiet = false, allow_other_code = false;
 };
 
 SweepCounts print_table_summary(const fs::path& dir, const SweepPlan& plan, const std::vector<CaseResult>& rows) {
@@ -64,7 +64,7 @@ void run(const SweepOptions& o) {
   const nlohmann::json stored_plan = sweep_plan_to_json(plan);
   if (o.collect) {
     NEEDLE_REQUIRE(fs::exists(dir / "sweep_plan.json"), fmt::format("--collect: {} holds no sweep (no sweep_plan.json)", dir.string()));
-    claim_study_folder(dir, "sweep_plan.json", stored_plan);
+    claim_study_folder(dir, "sweep_plan.json", stored_plan, o.allow_other_code);
     write_and_print_table(dir, plan);
     return;
   }
@@ -73,7 +73,7 @@ void run(const SweepOptions& o) {
     die_with_sweep_parent();
     NEEDLE_REQUIRE(task < static_cast<int>(plan.cases.size()),
                    fmt::format("--task-index {}: the sweep has cases 0 to {}", task, plan.cases.size() - 1));
-    claim_study_folder(dir, "sweep_plan.json", stored_plan);
+    claim_study_folder(dir, "sweep_plan.json", stored_plan, o.allow_other_code);
     const SweepCase& c = plan.cases[static_cast<size_t>(task)];
     if (read_done_case(dir, c.name, c.values)) {
       fmt::print("sweep: {} was done before\n", c.name);
@@ -92,7 +92,7 @@ void run(const SweepOptions& o) {
     const int threads = o.threads > 0 ? o.threads : std::max(1, hardware_threads() / std::max(1, local_ranks - 1));
     if (mpi.rank() == 0) {
       const auto infeasible = check_sweep_cases(plan);
-      claim_study_folder(dir, "sweep_plan.json", stored_plan);
+      claim_study_folder(dir, "sweep_plan.json", stored_plan, o.allow_other_code);
       if (!o.quiet)
         fmt::print(stderr, "sweep: {} cases ({} with tips that cannot be ground) on {} MPI ranks: {} worker(s), {} thread(s) a case\n", plan.cases.size(),
                    infeasible.size(), mpi.size(), std::max(1, mpi.size() - 1), threads);
@@ -102,12 +102,13 @@ void run(const SweepOptions& o) {
     return;
   }
   const auto infeasible = check_sweep_cases(plan);
-  claim_study_folder(dir, "sweep_plan.json", stored_plan);
+  claim_study_folder(dir, "sweep_plan.json", stored_plan, o.allow_other_code);
   SweepWorkers workers;
   workers.sweep_file = fs::absolute(o.file).string();
   workers.jobs = o.jobs;
   workers.threads_per_case = o.threads > 0 ? o.threads : std::max(1, hardware_threads() / o.jobs);
   workers.quiet = o.quiet;
+  workers.allow_other_code = o.allow_other_code;
   if (!o.quiet)
     fmt::print(stderr, "sweep: {} cases ({} with tips that cannot be ground), {} at a time, {} thread(s) a case, into {}\n", plan.cases.size(),
                infeasible.size(), workers.jobs, workers.threads_per_case, dir.string());
@@ -130,6 +131,8 @@ void add_sweep_command(CLI::App& app) {
   c->add_flag("--collect", o->collect, "Build the table from the cases done in --out (after a batch array)");
   c->add_flag("--count", o->count, "Print the number of cases and exit (for sbatch --array=0-(N-1))");
   c->add_flag("--quiet", o->quiet, "No progress lines");
+  c->add_flag("--allow-other-code", o->allow_other_code,
+              "Go on with a study whose cases another build of needle began (its study_code.txt names it): one table then mixes two codes' results");
   c->footer("Exit codes: 0 every case finished (or its tip cannot be ground); 3 the table is written but some cases stopped, timed out, "
             "failed or were not run; 2 bad input; 130 interrupted (the finished cases stay).");
   c->callback([o] { run(*o); });

@@ -151,8 +151,8 @@ OptimizationProblem read_optimization_file(const std::string& path) {
   return p;
 }
 
-OptimizationOutcome optimize_design(const OptimizationProblem& p, const fs::path& dir, int threads, bool quiet) {
-  claim_study_folder(dir, "optimize_plan.json", problem_to_json(p));
+OptimizationOutcome optimize_design(const OptimizationProblem& p, const fs::path& dir, int threads, bool quiet, bool allow_other_code) {
+  claim_study_folder(dir, "optimize_plan.json", problem_to_json(p), allow_other_code);
   // Only once the folder is claimed: an --out that cannot be used gets its one line and nothing before it.
   if (!quiet)
     fmt::print(stderr, "optimize: {} over {} variable(s), at most {} evaluations, into {}\n", p.method, p.variables.size(), p.max_evaluations,

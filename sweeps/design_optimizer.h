@@ -46,6 +46,7 @@ struct OptimizationOutcome {
 };
 
 // Runs the search into dir (created, or an earlier search of the same problem resumed). Progress on stderr unless quiet.
-OptimizationOutcome optimize_design(const OptimizationProblem& problem, const std::filesystem::path& dir, int threads, bool quiet);
+OptimizationOutcome optimize_design(const OptimizationProblem& problem, const std::filesystem::path& dir, int threads, bool quiet,
+                                    bool allow_other_code = false);
 
 }  // namespace needle

@@ -45,6 +45,7 @@ pid_t start_worker(const SweepCase& c, const fs::path& dir, const SweepWorkers& 
   const std::string log = (folder / "worker.log").string();
   std::vector<std::string> args = {"/proc/self/exe", "sweep", w.sweep_file, "--out", dir.string(), "--task-index", std::to_string(c.index),
                                    "--threads", std::to_string(w.threads_per_case), "--quiet"};
+  if (w.allow_other_code) args.push_back("--allow-other-code");
   std::vector<char*> argv;
   for (std::string& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);

@@ -17,6 +17,7 @@ struct SweepWorkers {
   int jobs = 1;               // worker processes at once
   int threads_per_case = 1;   // each case's worker threads (a run's results do not depend on it)
   bool quiet = false;         // no progress lines
+  bool allow_other_code = false;  // handed to the workers (--allow-other-code; sweep_plan.h)
   double case_time_limit_s = 0;  // a case running longer is stopped (SIGTERM, SIGKILL 10 s later) and recorded timed_out; 0: none
 };
 

@@ -9,6 +9,7 @@
 #include <set>
 
 #include "core/input_error.h"
+#include "core/provenance.h"
 #include "geometry/mesh_io.h"
 #include "runs/json_file.h"
 
@@ -233,21 +234,37 @@ std::map<int, std::string> check_sweep_cases(const SweepPlan& plan) {
   return infeasible;
 }
 
-void claim_study_folder(const fs::path& dir, const std::string& stored_name, const json& plan) {
+void claim_study_folder(const fs::path& dir, const std::string& stored_name, const json& plan, bool allow_other_code) {
   const fs::path file = dir / stored_name;
+  const fs::path code_file = dir / kStudyCodeFile;
+  // The code that runs the study's cases: a study goes on only with the code that began it, unless told otherwise.
+  const auto check_code = [&] {
+    if (!fs::exists(code_file)) {
+      write_file_atomically(code_file.string(), [&](const std::string& scratch) { std::ofstream(scratch) << provenance_line() << "\n"; });
+      return;
+    }
+    std::ifstream in(code_file);
+    std::string began;
+    std::getline(in, began);
+    NEEDLE_REQUIRE(allow_other_code || began == provenance_line(),
+                   fmt::format("--out {}: its cases were run by {}; this is {}: one table would mix two codes' results. Give a new --out, "
+                               "or --allow-other-code to go on with this one",
+                               dir.string(), began, provenance_line()));
+  };
   if (fs::exists(dir)) {
     NEEDLE_REQUIRE(fs::is_directory(dir), fmt::format("--out {}: exists and is not a folder", dir.string()));
     if (fs::exists(file)) {
       const json stored = read_json_file(file.string(), "study plan");
       NEEDLE_REQUIRE(stored == plan, fmt::format("--out {}: holds another study (its {} differs from this file's cases); give a new --out",
                                                  dir.string(), stored_name));
+      check_code();
       return;
     }
     // Empty, or only what another worker of the same study is writing just now (a Slurm array's tasks start together).
     bool only_study_files = true;
     for (const fs::directory_entry& entry : fs::directory_iterator(dir)) {
       const std::string name = entry.path().filename().string();
-      only_study_files = only_study_files && (name == "cases" || name.rfind(".needle-partial-", 0) == 0);
+      only_study_files = only_study_files && (name == "cases" || name == kStudyCodeFile || name.rfind(".needle-partial-", 0) == 0);
     }
     NEEDLE_REQUIRE(only_study_files, fmt::format("--out {}: is a folder that is not a study of the toolkit (no {}); give a new or empty one",
                                                   dir.string(), stored_name));
@@ -257,6 +274,7 @@ void claim_study_folder(const fs::path& dir, const std::string& stored_name, con
     fs::create_directories(dir);
   }
   write_file_atomically(file.string(), [&](const std::string& scratch) { std::ofstream(scratch) << plan.dump(2) << "\n"; });
+  check_code();
 }
 
 }  // namespace needle

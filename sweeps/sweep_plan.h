@@ -39,8 +39,13 @@ nlohmann::json sweep_plan_to_json(const SweepPlan& plan);
 // or when no case's tip can be ground. Returns the infeasible cases' reasons (index -> reason).
 std::map<int, std::string> check_sweep_cases(const SweepPlan& plan);
 
+// The file in a study's folder that names the code (core/provenance.h) that began it.
+inline constexpr const char* kStudyCodeFile = "study_code.txt";
 // The study folder for this plan: created with its plan file (stored_name, e.g. sweep_plan.json), or an existing
-// one whose plan file is the same study (cases may be done already). InputError otherwise, nothing changed.
-void claim_study_folder(const std::filesystem::path& dir, const std::string& stored_name, const nlohmann::json& plan);
+// one whose plan file is the same study (cases may be done already) and whose cases this code began (its
+// kStudyCodeFile; a folder from before has none and takes this code's). InputError otherwise, nothing changed:
+// another study, or another code unless allow_other_code (--allow-other-code).
+void claim_study_folder(const std::filesystem::path& dir, const std::string& stored_name, const nlohmann::json& plan,
+                        bool allow_other_code = false);
 
 }  // namespace needle

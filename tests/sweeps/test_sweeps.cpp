@@ -269,6 +269,24 @@ TEST_CASE("A sweep interrupted midway loses no finished case and repeats none wh
   CHECK(rerun.out.find("7 of 8 cases done before") != std::string::npos);
   CHECK(read_json(run3 / "summary.json")["status"] == "finished");
   CHECK(read_json(out / "sweep.json")["counts"]["finished"] == 8);
+  // The study names the code that began it; another build goes on only when told (issue 51: versions mixed in silence).
+  {
+    std::ifstream code_in(out / "study_code.txt");
+    std::string began;
+    std::getline(code_in, began);
+    CHECK(began.rfind("needle ", 0) == 0);
+    CHECK(began.find("commit") != std::string::npos);
+    write(out / "study_code.txt", "needle 0.0.1 (commit 000000000000, Release)\n");
+    const Result other_code = run("sweep " + (dir / "sweep.json").string() + " --out " + out.string(), true);
+    INFO(other_code.out);
+    CHECK(other_code.exit_code == 2);
+    CHECK(other_code.out.find("its cases were run by needle 0.0.1 (commit 000000000000, Release); this is " + began) != std::string::npos);
+    CHECK(std::count(other_code.out.begin(), other_code.out.end(), '\n') == 1);
+    const Result allowed = run("sweep " + (dir / "sweep.json").string() + " --out " + out.string() + " --allow-other-code", true);
+    INFO(allowed.out);
+    CHECK(allowed.exit_code == 0);
+    CHECK(allowed.out.find("8 of 8 cases done before") != std::string::npos);
+  }
   // Another sweep into the same folder is refused, the folder untouched.
   write(dir / "other.json", R"({"base": {"scene": "scene.json"}, "variables": {"tissue.friction": [0.3]}})");
   const Result other = run("sweep " + (dir / "other.json").string() + " --out " + out.string(), true);
