@@ -13,7 +13,6 @@
 
 #include "apps/cli_checks.h"
 #include "runs/insertion_run.h"
-#include "runs/model_levels.h"
 #include "apps/scene_overrides.h"
 #include "runs/json_file.h"
 #include "studies/paper_report.h"
@@ -73,9 +72,7 @@ void paper(const PaperOptions& o) {
   // `needle run` does (issue 49: the card's E 0.665 MPa put SB at -4.19 mm); --report-only reads E from the runs.
   std::string calibration_file = o.calibration_file;
   if (calibration_file.empty() && std::isnan(o.tissue_E_MPa) && !o.report_only) {
-    Scene probe = scene;
-    apply_scene_overrides(probe, o.overrides);
-    calibration_file = default_calibration_file(model_level_of(probe));
+    calibration_file = default_calibration_after(scene, o.overrides);
     scene.tissue.material.E_MPa = calibrated_E(calibration_file);
     E_source = fmt::format("calibrated on SB: {} (the shipped calibration of the model level)", calibration_file);
   }

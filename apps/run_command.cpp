@@ -43,13 +43,7 @@ void run(const RunCommandOptions& o) {
     scene.tissue.material.E_MPa = o.tissue_E_MPa;
     E_source = "given with --tissue-E-MPa";
   } else if (!o.calibration_file.empty() || o.scene_file.empty()) {
-    // The shipped calibration of the model level the run will have (--model and --set come last).
-    const auto level = [&] {
-      Scene probe = scene;
-      apply_scene_overrides(probe, o.overrides);
-      return model_level_of(probe);
-    };
-    const std::string file = o.calibration_file.empty() ? default_calibration_file(level()) : o.calibration_file;
+    const std::string file = o.calibration_file.empty() ? default_calibration_after(scene, o.overrides) : o.calibration_file;
     scene.tissue.material.E_MPa = calibrated_E(file);
     E_source = fmt::format("calibrated on SB: {}", file);
   }

@@ -5,6 +5,7 @@
 #include <fmt/ranges.h>
 
 #include "core/input_error.h"
+#include "runs/insertion_run.h"
 #include "runs/model_levels.h"
 #include "solver/contact/needle_tissue_contact.h"
 
@@ -45,8 +46,9 @@ void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
     scene.tissue.material.law = tissue_law_from_name(o.tissue_law);
     scene.tissue.material.validate();
   }
-  NEEDLE_REQUIRE(std::isnan(o.tissue_friction) || o.tissue_friction <= 2.0,
-                 fmt::format("--tissue-friction must lie in [0, 2] (a friction coefficient; the paper's 0.18; got {})", o.tissue_friction));
+  NEEDLE_REQUIRE(std::isnan(o.tissue_friction) || o.tissue_friction <= kMaxFrictionCoefficient,
+                 fmt::format("--tissue-friction must lie in [0, {:g}] (a friction coefficient; the paper's 0.18; got {})", kMaxFrictionCoefficient,
+                             o.tissue_friction));
   if (given_or_zero(o.tissue_friction, "--tissue-friction"))
     scene.tissue.friction = scene.tissue.contact.friction = o.tissue_friction;  // as the scene key tissue.friction sets both
   if (!o.tissue_size_mm.empty()) {
@@ -207,6 +209,12 @@ std::string scene_override_arguments(const SceneOverrides& o) {
   number("--contact-stiffness-factor", o.contact_stiffness_factor);
   number("--tissue-entry-x-mm", o.tissue_entry_x_mm);
   return line;
+}
+
+std::string default_calibration_after(const Scene& scene, const SceneOverrides& overrides) {
+  Scene probe = scene;
+  apply_scene_overrides(probe, overrides);
+  return default_calibration_file(model_level_of(probe));
 }
 
 }  // namespace needle

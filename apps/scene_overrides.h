@@ -39,6 +39,9 @@ struct SceneOverrides {
 };
 // InputError naming the flag for a value that is not a positive number.
 void apply_scene_overrides(Scene& scene, const SceneOverrides& overrides);
+// The shipped SB calibration of the model level the scene will have once the overrides are applied (--model and
+// --set come last): the default E of `needle run` and `needle paper`.
+std::string default_calibration_after(const Scene& scene, const SceneOverrides& overrides);
 // The flags run, paper and calibrate share: --model, --travel-mm, --spacing-mm, --path-refinement, --no-needle-cut, --tissue-nu,
 // --tissue-friction, --tissue-law, --speed-m-per-s, --decel-time-ms, --hold-ms, --tissue-size-mm, --slit-half-height-mm, --relaxing-shear-fraction, --relaxation-time-ms, --cutting-pressure-mpa,
 // --crack-reach-mm, --crack-angles-deg, --crack-lead-mm, --groove-start-mm, --contact-skin-mm, --contact-stiffness-factor,

@@ -15,9 +15,12 @@
 namespace needle {
 namespace {
 
-// A Coulomb coefficient between steel and soft tissue or gel: 0.05-0.5 measured; above 2 no scene means it.
 ValueCheck friction_coefficient() {
-  return [](double v) { return v >= 0 && v <= 2.0 ? std::string() : std::string("must lie in [0, 2] (a friction coefficient; the paper's 0.18)"); };
+  return [](double v) {
+    return v >= 0 && v <= kMaxFrictionCoefficient
+               ? std::string()
+               : fmt::format("must lie in [0, {:g}] (a friction coefficient; the paper's 0.18)", kMaxFrictionCoefficient);
+  };
 }
 
 using nlohmann::json;
@@ -81,9 +84,10 @@ void read_needle(SceneObject o, NeedleScene& n, const std::string& scene_folder)
 void read_motion(SceneObject o, Scene& s) {
   InsertionProfile& p = s.motion;
   p.accel_time_ms = o.quantity("accel_time", Dimension::time, p.accel_time_ms, non_negative());
-  // Physical range: a biopsy gun fires at a few m/s (the paper's drive 8 m/s); beyond 100 m/s no scene means it.
   p.speed_mm_per_ms = o.quantity("speed", Dimension::speed, p.speed_mm_per_ms, [](double v) {
-    return v > 0 && v <= 100.0 ? std::string() : std::string("must be positive and at most 100 m/s (the paper's drive: 8 m/s)");
+    return v > 0 && v <= InsertionProfile::kMaxSpeedMPerS
+               ? std::string()
+               : fmt::format("must be positive and at most {:g} m/s (the paper's drive: 8 m/s)", InsertionProfile::kMaxSpeedMPerS);
   });
   p.travel_mm = o.quantity("travel", Dimension::length, p.travel_mm, positive());
   p.decel_time_ms = o.quantity("decel_time", Dimension::time, p.decel_time_ms, non_negative());

@@ -24,9 +24,13 @@
 
 namespace needle {
 
+// A Coulomb coefficient between steel and soft tissue or gel: 0.05-0.5 measured; above this no scene means it
+// (the scene reader and the --tissue-friction flag refuse it).
+constexpr double kMaxFrictionCoefficient = 2.0;
+
 struct ContactOptions {
   std::string law = "penalty";    // "penalty" or "projection" (contact_laws.h)
-  double friction = 0.18;         // Coulomb coefficient needle-tissue (paper)
+  double friction = 0.18;         // Coulomb coefficient needle-tissue (paper), at most kMaxFrictionCoefficient
   double stiffness_factor = 30.0; // penalty stiffness over the particle's own (penalty_contact.h); at 30 it lets no particle
                                   // deeper than 0.023 mm inside the needle over the paper's 30 mm (10: 0.07 mm; docs/notebook/paper_studies.md)
   double skin_mm = 0.02;          // contact starts this far outside the surface (projection: particles are put back this far out) (0.04 until the skin study showed AMB's

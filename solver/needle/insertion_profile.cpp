@@ -13,8 +13,6 @@ void InsertionProfile::validate(const std::string& where) const {
                  fmt::format("{}: accel_time_ms must be zero or positive (got {})", where, accel_time_ms));
   NEEDLE_REQUIRE(std::isfinite(speed_mm_per_ms) && speed_mm_per_ms > 0,
                  fmt::format("{}: the insertion speed must be positive (got {} m/s)", where, speed_mm_per_ms));
-  // A biopsy gun fires at a few m/s (the paper's drive 8): beyond 100 m/s a speed is a typo.
-  constexpr double kMaxSpeedMPerS = 100.0;
   NEEDLE_REQUIRE(speed_mm_per_ms <= kMaxSpeedMPerS,
                  fmt::format("{}: insertion speed {} m/s is beyond any biopsy device (at most {} m/s)", where, speed_mm_per_ms, kMaxSpeedMPerS));
   NEEDLE_REQUIRE(std::isfinite(travel_mm) && travel_mm > 0, fmt::format("{}: travel_mm must be positive (got {})", where, travel_mm));

@@ -11,6 +11,8 @@
 namespace needle {
 
 struct InsertionProfile {
+  // A biopsy gun fires at a few m/s (the paper's drive 8 m/s): beyond this a speed is a typo (validate, the scene reader).
+  static constexpr double kMaxSpeedMPerS = 100.0;
   double accel_time_ms = 0.75;
   double speed_mm_per_ms = 8.0;
   double travel_mm = 30.0;

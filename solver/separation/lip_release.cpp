@@ -31,19 +31,37 @@ void LipReleaseOptions::validate(const std::string& where) const {
   NEEDLE_REQUIRE(std::isfinite(below_mm) && below_mm >= 0, fmt::format("{}: below_mm must be zero or positive (got {})", where, below_mm));
 }
 
+namespace {
+
+// The needle's frame as the lip sees it: the tip point A (its most distal node) and the rod's radius about y = z = 0.
+struct LipFrame {
+  Eigen::Index tip_node = 0;
+  Eigen::Vector3d tip_mm = Eigen::Vector3d::Zero();
+  double rod_radius_mm = 0;
+};
+
+LipFrame lip_frame(const Eigen::MatrixX3d& needle_reference_mm) {
+  NEEDLE_REQUIRE(needle_reference_mm.rows() > 0, "lip_release: the needle has no nodes");
+  LipFrame f;
+  needle_reference_mm.col(0).maxCoeff(&f.tip_node);
+  f.tip_mm = needle_reference_mm.row(f.tip_node).transpose();
+  f.rod_radius_mm = needle_reference_mm.rightCols<2>().rowwise().norm().maxCoeff();
+  return f;
+}
+
+}  // namespace
+
 LipRelease::LipRelease(const Eigen::MatrixX3d& needle_reference_mm, const LipReleaseOptions& options) : options_(options) {
   options_.validate();
-  NEEDLE_REQUIRE(needle_reference_mm.rows() > 0, "lip_release: the needle has no nodes");
-  needle_reference_mm.col(0).maxCoeff(&tip_node_);
-  tip_reference_mm_ = needle_reference_mm.row(tip_node_).transpose();
-  rod_radius_mm_ = needle_reference_mm.rightCols<2>().rowwise().norm().maxCoeff();
+  const LipFrame f = lip_frame(needle_reference_mm);
+  tip_node_ = f.tip_node;
+  tip_reference_mm_ = f.tip_mm;
+  rod_radius_mm_ = f.rod_radius_mm;
 }
 
 double LipRelease::lip_thickness_mm(const Eigen::MatrixX3d& needle_reference_mm) {
-  NEEDLE_REQUIRE(needle_reference_mm.rows() > 0, "lip_release: the needle has no nodes");
-  Eigen::Index tip = 0;
-  needle_reference_mm.col(0).maxCoeff(&tip);
-  return needle_reference_mm(tip, 1) + needle_reference_mm.rightCols<2>().rowwise().norm().maxCoeff();
+  const LipFrame f = lip_frame(needle_reference_mm);
+  return f.tip_mm.y() + f.rod_radius_mm;
 }
 
 std::vector<std::int32_t> LipRelease::particles_in_band(const std::vector<Vec3d>& x, const Eigen::MatrixX3d& needle_x) const {
@@ -52,11 +70,11 @@ std::vector<std::int32_t> LipRelease::particles_in_band(const std::vector<Vec3d>
   const Eigen::Vector3d tip = needle_x.row(tip_node_).transpose();
   const Eigen::Vector3d axis = tip - tip_reference_mm_;  // the needle frame's origin moved with A (x unused)
   const double r2 = rod_radius_mm_ * rod_radius_mm_;
+  const double top_y = tip.y() - options_.below_mm;
   for (size_t i = 0; i < x.size(); ++i) {
     if (!released_.empty() && released_[i]) continue;
     const Vec3d& p = x[i];
     if (p.x() > tip.x() || p.x() < tip.x() - kWindowBehindMm) continue;
-    const double top_y = tip.y() - options_.below_mm;
     if (p.y() >= top_y || p.y() < top_y - options_.depth_mm) continue;
     const double dy = p.y() - axis.y(), dz = p.z() - axis.z();
     if (dy * dy + dz * dz <= r2) found.push_back(static_cast<std::int32_t>(i));

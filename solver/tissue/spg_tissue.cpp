@@ -181,7 +181,8 @@ void SpgTissue::update_point(size_t s, double dt_ms) {
       point.relaxed_stress_MPa = p_.relaxed_stress_MPa[s];
       point.elastic_deviator_MPa = p_.elastic_deviator_MPa[s];
     }
-    const StressUpdate u = update_stress(material_, point, F * p_.deformation_gradient[s].inverse(), dt_ms);
+    StressUpdate u = update_stress(material_, point, F * p_.deformation_gradient[s].inverse(), dt_ms);
+    if (p_.flags[s] & kParticleCrushed) keep_pressure_only(u);
     p_.stress_MPa[s] = u.cauchy_stress_MPa;
     p_.elastic_left_cauchy_green[s] = u.state.elastic_left_cauchy_green;
     p_.plastic_strain[s] = u.state.plastic_strain;
@@ -191,7 +192,6 @@ void SpgTissue::update_point(size_t s, double dt_ms) {
     }
     p_.effective_strain[s] = u.effective_strain;
     if (u.rate_factor_capped) status[s] = kCapped;
-    if (p_.flags[s] & kParticleCrushed) keep_pressure_only(s);
   }
   p_.deformation_gradient[s] = F;
   set_stretch_bounds(s);
@@ -402,19 +402,6 @@ void SpgTissue::detach(size_t s) {
   p_.stress_MPa[s].setZero();
   reset_material_state(s);
   p_.effective_strain[s] = p_.plastic_strain[s];
-}
-
-void SpgTissue::keep_pressure_only(size_t s) {
-  // Crushed material (kParticleCrushed): no shear stress, and no elastic shear strain stored to bring one back;
-  // the pressure and the elastic volume change stay.
-  Mat3d& sigma = p_.stress_MPa[s];
-  sigma = (sigma.trace() / 3.0) * Mat3d::Identity();
-  Mat3d& b = p_.elastic_left_cauchy_green[s];
-  b = std::cbrt(std::max(b.determinant(), 0.0)) * Mat3d::Identity();
-  if (material_.viscoelastic()) {
-    p_.relaxed_stress_MPa[s].setZero();
-    p_.elastic_deviator_MPa[s].setZero();
-  }
 }
 
 void SpgTissue::reset_material_state(size_t s) {

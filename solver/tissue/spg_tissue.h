@@ -114,8 +114,6 @@ class SpgTissue {
   // Particle s stops being an integration point: its row, smoothing defect and stress are cleared; it
   // moves on as a free mass point.
   void detach(size_t s);
-  // Crushed material at s (kParticleCrushed): its stress and elastic strain keep only their volumetric parts.
-  void keep_pressure_only(size_t s);
   // An unloaded material at s: b_e = I and, if viscoelastic, no Maxwell stress (the particle stopped being
   // an integration point).
   void reset_material_state(size_t s);

@@ -201,4 +201,13 @@ double uniaxial_true_stress_MPa(const TissueMaterial& m, double true_strain, dou
   return mat018_uniaxial_true_stress_MPa(m, true_strain, strain_rate_per_ms);
 }
 
+void keep_pressure_only(StressUpdate& update) {
+  Eigen::Matrix3d& sigma = update.cauchy_stress_MPa;
+  sigma = (sigma.trace() / 3.0) * Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d& b = update.state.elastic_left_cauchy_green;
+  b = std::cbrt(std::max(b.determinant(), 0.0)) * Eigen::Matrix3d::Identity();
+  update.state.relaxed_stress_MPa.setZero();
+  update.state.elastic_deviator_MPa.setZero();
+}
+
 }  // namespace needle

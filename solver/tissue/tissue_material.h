@@ -144,6 +144,11 @@ StressUpdate update_stress(const TissueMaterial& material, const MaterialPoint& 
 StressUpdate update_stress_by_eigenvalues(const TissueMaterial& material, const MaterialPoint& state, const Eigen::Matrix3d& relative_F,
                                           double dt_ms);
 
+// Crushed material (the lip release's kParticleCrushed, solver/separation/lip_release.h): the update's Cauchy stress and
+// elastic b_e keep only their volumetric parts, so no shear stress is stored to come back at the next update, and a
+// viscoelastic point's Maxwell stresses are cleared.
+void keep_pressure_only(StressUpdate& update);
+
 // The closed-form uniaxial curve of the card: Cauchy (true) stress at a true (log) strain pulled at a
 // constant true strain rate (elastic to the rate-scaled yield, then on sigma_y(eps - sigma / E)). A scalar
 // equation solved by bisection; independent of update_stress, for tests and plots.

@@ -1,6 +1,7 @@
 #pragma once
 // The small coupled runs the CLI tests make: a plain rod or a short SB pushed 0.8 mm into a small tissue block
 // by `needle run --scene`, the run folder's files read back, and refused runs checked (tests only).
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
@@ -64,6 +65,13 @@ inline std::string refused_on_small_block(const std::string& name, const std::st
   CHECK(bad.out.find(message) != std::string::npos);
   CHECK(!fs::exists(dir / "run"));
   return bad.out;
+}
+
+// The same, and the refusal is one line.
+inline void refused_in_one_line(const std::string& name, const std::string& flags, const std::string& message) {
+  const std::string out = refused_on_small_block(name, flags, message);
+  INFO(flags << ": " << out);
+  CHECK(std::count(out.begin(), out.end(), '\n') == 1);
 }
 
 // A 26 mm SB (T4 0.5 mm, no cannula) pushed 0.8 mm into the small block.

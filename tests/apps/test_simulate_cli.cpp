@@ -384,13 +384,7 @@ TEST_CASE("Ctrl-C during a run writes what there is, marked interrupted, exits 1
       "{} simulate {}/data/scenes/sb_quick.json --out {} --quiet 2>&1 & pid=$!; "
       "for i in $(seq 300); do [ -s {} ] && break; sleep 0.05; done; sleep 0.5; kill -INT $pid; wait $pid; echo \"exit $?\"",
       NEEDLE_BINARY, NEEDLE_SOURCE_DIR, out.string(), partial.string());
-  FILE* pipe = popen(command.c_str(), "r");
-  REQUIRE(pipe);
-  std::string text;
-  char buffer[4096];
-  size_t n;
-  while ((n = fread(buffer, 1, sizeof buffer, pipe)) > 0) text.append(buffer, n);
-  pclose(pipe);
+  const std::string text = shell(command).out;
   INFO(text);
   CHECK(text.find("needle: interrupted by SIGINT at t = ") != std::string::npos);
   CHECK(text.find("exit 130") != std::string::npos);
@@ -416,13 +410,7 @@ TEST_CASE("Two writers on one run folder: the second is refused with the first's
       "{0} simulate {1}/data/scenes/sb_quick.json --out {2} --quiet 2>&1; echo \"second exit $? first pid $pid\"; "
       "wait $pid; echo \"first exit $?\"",
       NEEDLE_BINARY, NEEDLE_SOURCE_DIR, out.string(), dir.string(), partial.string());
-  FILE* pipe = popen(command.c_str(), "r");
-  REQUIRE(pipe);
-  std::string text;
-  char buffer[4096];
-  size_t n;
-  while ((n = fread(buffer, 1, sizeof buffer, pipe)) > 0) text.append(buffer, n);
-  pclose(pipe);
+  const std::string text = shell(command).out;
   INFO(text);
   const auto pid_at = text.find("first pid ");
   REQUIRE(pid_at != std::string::npos);

@@ -54,16 +54,7 @@ std::map<std::string, double> deflections(const fs::path& out) {
   return d;
 }
 
-std::string stderr_of(const std::string& command) {
-  FILE* pipe = popen(("(" + command + ") 2>&1").c_str(), "r");
-  REQUIRE(pipe);
-  std::string out;
-  char buffer[4096];
-  size_t n;
-  while ((n = fread(buffer, 1, sizeof buffer, pipe)) > 0) out.append(buffer, n);
-  pclose(pipe);
-  return out;
-}
+std::string stderr_of(const std::string& command) { return shell("(" + command + ") 2>&1").out; }
 
 }  // namespace
 
