@@ -63,7 +63,7 @@ std::string one_line(const char* what) {
 
 int main(int argc, char** argv) {
   CLI::App app{"needle: design biopsy needle tips - grinding CAD, meshing and insertion simulation"};
-  app.set_version_flag("--version", needle::provenance_line(), "Print the toolkit's version and the commit it was built from, and exit");
+  app.set_version_flag("--version", needle::provenance_line() + "\n" + needle::numerical_libraries_line(), "Print the toolkit's version and the commit it was built from, and exit");
   app.require_subcommand(1);
   needle::add_tip_command(app);
   needle::add_mesh_command(app);

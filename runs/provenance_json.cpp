@@ -6,7 +6,7 @@ namespace needle {
 
 nlohmann::json provenance_json() {
   const Provenance& p = provenance();
-  return {{"version", p.version}, {"commit", p.commit}, {"uncommitted_changes", p.dirty}, {"build_type", p.build_type}};
+  return {{"version", p.version}, {"commit", p.commit}, {"uncommitted_changes", p.dirty}, {"build_type", p.build_type}, {"blas", p.blas}, {"lapack", p.lapack}};
 }
 
 }  // namespace needle

@@ -4,9 +4,10 @@
 # --checking also installs what the checking build needs (scripts/test-sanitizers.sh): clang with its sanitizer
 # and libFuzzer runtimes.
 # Safe to run again: apt-get skips what is already there.
-# --no-install-recommends matters: python3-openturns recommends ATLAS, whose libblas.so.3 would take over Debian's BLAS
-# alternative from the reference BLAS and move the implicit needle's results in their last digits (CHOLMOD calls it;
-# ../shared/DEPENDENCIES.md). The end of this script checks the alternative and says so if another BLAS holds it.
+# The reference BLAS and LAPACK (libblas-dev, liblapack-dev) are linked by path into the executables, so CHOLMOD calls them
+# whichever BLAS Debian's alternative selects (solver/CMakeLists.txt); ATLAS (libatlas3-base) is installed as the other
+# BLAS that tests/apps/test_blas_pin.cpp runs a scene with. Installing it makes ATLAS the system's libblas.so.3 for
+# other programs (numpy, OpenTURNS); needle's results do not move with it. --no-install-recommends keeps the rest lean.
 set -euo pipefail
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
@@ -20,21 +21,18 @@ PACKAGES=(
   catch2
   nlohmann-json3-dev libcli11-dev libfmt-dev libspdlog-dev
   libpng-dev libfreetype-dev fonts-dejavu-core
-  libsuitesparse-dev libspectra-dev
+  libsuitesparse-dev libspectra-dev libblas-dev liblapack-dev libatlas3-base
   libnlopt-dev libnlopt-cxx-dev libopenmpi-dev openmpi-bin
   python3-meshio
   python3-openturns python3-matplotlib
   python3-paraview xvfb xauth
 )
 if [ "${1:-}" = "--checking" ]; then PACKAGES+=(clang libclang-rt-14-dev); fi
-# Which BLAS Debian's alternative selects: a note when it is not the reference one.
+# Which BLAS Debian's alternative selects, for the record: needle itself loads the reference one.
 check_blas() {
   local selected
   selected="$(readlink -f /usr/lib/x86_64-linux-gnu/libblas.so.3 2>/dev/null || true)"
-  case "$selected" in
-    */blas/libblas.so.3*|"") ;;
-    *) echo "install-deps: note: libblas.so.3 is $selected, not the reference BLAS; the implicit needle's results may differ from the stored ones in their last digits (update-alternatives --config libblas.so.3-x86_64-linux-gnu)" ;;
-  esac
+  echo "install-deps: the system's libblas.so.3 is ${selected:-none}; needle links the reference BLAS (needle --version names it)"
 }
 missing=()
 for p in "${PACKAGES[@]}"; do
