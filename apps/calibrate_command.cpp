@@ -23,6 +23,7 @@
 #include "apps/scene_overrides.h"
 #include "runs/json_file.h"
 #include "runs/scene.h"
+#include "runs/writer_lock.h"
 #include "core/input_error.h"
 #include "geometry/mesh_io.h"
 #include "plot/line_plot.h"
@@ -111,9 +112,10 @@ void calibrate(const CalibrateOptions& o) {
   apply_scene_overrides(scene, o.overrides);
   const double start = std::isnan(o.start_E_MPa) ? scene.tissue.material.E_MPa : o.start_E_MPa;
   NEEDLE_REQUIRE(std::isfinite(start) && start > 0, "--start-E-MPa must be positive");
-  const fs::path dir(o.out_dir);
+  const fs::path dir = named_folder(o.out_dir);
   NEEDLE_REQUIRE(fs::is_directory(fs::absolute(dir).parent_path()),
                  fmt::format("the folder '{}' that should hold the calibration does not exist", fs::absolute(dir).parent_path().string()));
+  const auto lock = lock_output_folder(dir);
   fs::create_directories(dir / "runs");
 
   std::vector<Evaluation> runs;

@@ -8,6 +8,7 @@
 #include "apps/cli_checks.h"
 #include "core/parallel.h"
 #include "sweeps/design_optimizer.h"
+#include "runs/writer_lock.h"
 
 namespace needle {
 namespace fs = std::filesystem;
@@ -22,6 +23,7 @@ struct OptimizeOptions {
 void run(const OptimizeOptions& o) {
   const OptimizationProblem problem = read_optimization_file(o.file);
   const int threads = o.threads > 0 ? o.threads : hardware_threads();
+  const auto lock = lock_output_folder(o.out_dir);
   const OptimizationOutcome outcome = optimize_design(problem, o.out_dir, threads, o.quiet, o.allow_other_code);
   fmt::print("optimize: {} evaluations; stopped: {}\n", outcome.evaluations.size(), outcome.stop_reason);
   if (outcome.best < 0) {

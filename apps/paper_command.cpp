@@ -17,6 +17,7 @@
 #include "runs/json_file.h"
 #include "studies/paper_report.h"
 #include "runs/scene.h"
+#include "runs/writer_lock.h"
 #include "core/input_error.h"
 
 #ifndef NEEDLE_DATA_DIR
@@ -88,10 +89,11 @@ void paper(const PaperOptions& o) {
                      fmt::format("{} {}: no file '{}'", flag, models->back().label, models->back().results_path));
     }
 
-  const fs::path dir(o.out_dir);
+  const fs::path dir = named_folder(o.out_dir);
   const fs::path parent = fs::absolute(dir).parent_path();
   NEEDLE_REQUIRE(fs::is_directory(parent), fmt::format("the folder '{}' that should hold the report does not exist", parent.string()));
   NEEDLE_REQUIRE(!fs::exists(dir) || fs::is_directory(dir), fmt::format("'{}' exists and is not a folder", dir.string()));
+  const auto lock = lock_output_folder(dir);
   if (!o.report_only) {
     fs::create_directories(dir / "runs");
     for (const std::string& name : needles) {
@@ -139,7 +141,7 @@ void paper(const PaperOptions& o) {
     }
   }
   PaperReportInput report;
-  report.out_dir = o.out_dir;
+  report.out_dir = dir.string();
   report.needles = needles;
   report.reference = reference;
   report.reference_path = o.reference;

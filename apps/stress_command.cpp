@@ -12,6 +12,7 @@
 #include "sweeps/sweep_executor.h"
 #include "sweeps/sweep_plan.h"
 #include "sweeps/sweep_table.h"
+#include "runs/writer_lock.h"
 
 #ifndef NEEDLE_DATA_DIR
 #define NEEDLE_DATA_DIR "data"
@@ -36,8 +37,9 @@ void run(const StressOptions& o) {
   NEEDLE_REQUIRE(o.case_time_limit_s >= 0,
                  "--case-time-limit-s must be positive, or 0 for the suite's default (900 s; 120 s with --short)");
   const SweepPlan plan = read_sweep_file(suite);
-  check_sweep_cases(plan);
   const fs::path dir(o.out_dir);
+  const auto lock = lock_output_folder(dir);
+  check_sweep_cases(plan);
   claim_study_folder(dir, "sweep_plan.json", sweep_plan_to_json(plan), o.allow_other_code);
   SweepWorkers workers;
   workers.sweep_file = fs::absolute(suite).string();

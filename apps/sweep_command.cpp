@@ -14,6 +14,7 @@
 #include "sweeps/sweep_mpi.h"
 #include "sweeps/sweep_plan.h"
 #include "sweeps/sweep_table.h"
+#include "runs/writer_lock.h"
 
 #ifndef NEEDLE_DATA_DIR
 #define NEEDLE_DATA_DIR "data"
@@ -64,6 +65,7 @@ void run(const SweepOptions& o) {
   const nlohmann::json stored_plan = sweep_plan_to_json(plan);
   if (o.collect) {
     NEEDLE_REQUIRE(fs::exists(dir / "sweep_plan.json"), fmt::format("--collect: {} holds no sweep (no sweep_plan.json)", dir.string()));
+    const auto lock = lock_output_folder(dir);
     claim_study_folder(dir, "sweep_plan.json", stored_plan, o.allow_other_code);
     write_and_print_table(dir, plan);
     return;
@@ -90,7 +92,9 @@ void run(const SweepOptions& o) {
     const char* local = std::getenv("OMPI_COMM_WORLD_LOCAL_SIZE");
     const int local_ranks = local ? std::max(1, std::atoi(local)) : 1;
     const int threads = o.threads > 0 ? o.threads : std::max(1, hardware_threads() / std::max(1, local_ranks - 1));
+    std::unique_ptr<WriterLock> lock;  // held by the rank that writes the table; the others run cases only
     if (mpi.rank() == 0) {
+      lock = lock_output_folder(dir);
       const auto infeasible = check_sweep_cases(plan);
       claim_study_folder(dir, "sweep_plan.json", stored_plan, o.allow_other_code);
       if (!o.quiet)
@@ -101,6 +105,9 @@ void run(const SweepOptions& o) {
     if (mpi.rank() == 0) write_and_print_table(dir, plan);
     return;
   }
+  // The parent holds the folder while its workers run one case each (a worker, like a batch array's task, takes no folder
+  // lock: its case's run folder has its own).
+  const auto lock = lock_output_folder(dir);
   const auto infeasible = check_sweep_cases(plan);
   claim_study_folder(dir, "sweep_plan.json", stored_plan, o.allow_other_code);
   SweepWorkers workers;

@@ -45,6 +45,16 @@ WriterLock::WriterLock(const std::filesystem::path& folder, const std::string& s
   throw InputError(fmt::format("cannot lock '{}' for '{}': its lock file keeps changing", path_.string(), shown));
 }
 
+std::filesystem::path named_folder(const std::filesystem::path& path) { return path.has_filename() ? path : path.parent_path(); }
+
+std::unique_ptr<WriterLock> lock_output_folder(const std::filesystem::path& folder) {
+  const std::filesystem::path named = named_folder(folder);
+  NEEDLE_REQUIRE(!named.empty(), "--out: give a folder");
+  const std::filesystem::path parent = std::filesystem::absolute(named).parent_path();
+  NEEDLE_REQUIRE(std::filesystem::is_directory(parent), fmt::format("--out {}: its parent folder does not exist", folder.string()));
+  return std::make_unique<WriterLock>(named, named.string());
+}
+
 WriterLock::~WriterLock() {
   if (fd_ < 0) return;
   ::unlink(path_.c_str());  // still holding it: the next writer creates a fresh file

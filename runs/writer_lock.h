@@ -6,6 +6,7 @@
 // writer that ends removes the file while it still holds it; a writer that locked a file just removed notices
 // (the path no longer names it) and tries again, so two writers never hold two files of one name.
 #include <filesystem>
+#include <memory>
 #include <string>
 
 namespace needle {
@@ -26,5 +27,13 @@ class WriterLock {
   std::filesystem::path path_;
   int fd_ = -1;
 };
+
+// The folder a path names: "out/" (a shell's completion) names out.
+std::filesystem::path named_folder(const std::filesystem::path& path);
+
+// What a command that writes a folder (a sweep, a search, a report, a calibration, the stress suite) takes before
+// anything is written: the folder's lock, so that a second command on the same --out is refused at once with one line
+// naming the first's pid. InputError "--out DIR: its parent folder does not exist" first where it does not.
+std::unique_ptr<WriterLock> lock_output_folder(const std::filesystem::path& folder);
 
 }  // namespace needle
