@@ -250,6 +250,15 @@ std::optional<CaseResult> read_done_case(const fs::path& study_dir, const std::s
   if (!fs::exists(file)) return std::nullopt;
   const CaseResult r = case_result_from_json(read_json_file(file.string(), "case record"), file.string());
   if (!r.done() || r.values != values) return std::nullopt;
+  if (!r.run_folder.empty()) {
+    const fs::path summary = study_dir / r.run_folder / "summary.json";
+    if (!fs::is_regular_file(summary)) return std::nullopt;
+    try {
+      if (run_outcome(read_json_file(summary.string(), "run summary")).status != r.status) return std::nullopt;
+    } catch (const InputError&) {
+      return std::nullopt;  // a summary cut short or not a run's: the case runs again
+    }
+  }
   return r;
 }
 

@@ -82,7 +82,9 @@ CaseResult case_result_from_json(const nlohmann::json& json, const std::string& 
 
 // The case's folder inside a study folder: DIR/cases/<name>.
 std::filesystem::path case_folder(const std::filesystem::path& study_dir, const std::string& case_name);
-// The case's record if DIR/cases/<name>/case.json holds a done case of these variables.
+// The case's record if DIR/cases/<name>/case.json holds a done case of these variables and, for a case that ran, its
+// run folder still holds the run it records (its summary.json with the same status): a record whose run was lost or
+// replaced is not done, and the case runs again.
 std::optional<CaseResult> read_done_case(const std::filesystem::path& study_dir, const std::string& case_name, const nlohmann::json& values);
 
 // Runs the case into DIR/cases/<name>/run (reusing a finished run of the same scene there) and writes case.json

@@ -260,6 +260,18 @@ TEST_CASE("A sweep interrupted midway loses no finished case and repeats none wh
   CHECK(rerun.out.find("7 of 8 cases done before") != std::string::npos);
   CHECK(read_json(run3 / "summary.json")["status"] == "finished");
   CHECK(read_json(out / "sweep.json")["counts"]["finished"] == 8);
+  // A case recorded finished whose run folder is gone (deleted, or lost to a second writer before the folder locks)
+  // is not done: it runs again, and the others are kept (issue 51: "a rerun says 4 of 4 done").
+  const fs::path record5 = out / "cases" / "case_0005" / "case.json";
+  const auto record5_time = fs::last_write_time(record5);
+  fs::remove_all(out / "cases" / "case_0005" / "run");
+  const Result lost = run("sweep " + (dir / "sweep.json").string() + " --out " + out.string(), true);
+  INFO(lost.out);
+  REQUIRE(lost.exit_code == 0);
+  CHECK(lost.out.find("7 of 8 cases done before") != std::string::npos);
+  CHECK(fs::is_regular_file(out / "cases" / "case_0005" / "run" / "summary.json"));
+  CHECK(fs::last_write_time(record5) != record5_time);
+  CHECK(read_json(out / "sweep.json")["counts"]["finished"] == 8);
   // The study names the code that began it; another build goes on only when told (issue 51: versions mixed in silence).
   {
     std::ifstream code_in(out / "study_code.txt");
