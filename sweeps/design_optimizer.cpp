@@ -1,7 +1,6 @@
 #include "sweeps/design_optimizer.h"
 
 #include <algorithm>
-#include <boost/math/tools/toms748_solve.hpp>
 #include <chrono>
 #include <exception>
 #include <fmt/format.h>
@@ -15,6 +14,7 @@
 #include "geometry/mesh_io.h"
 #include "runs/recipe_json.h"
 #include "sweeps/sweep_plan.h"
+#include "sweeps/target_bracket.h"
 
 namespace needle {
 namespace fs = std::filesystem;
@@ -203,38 +203,20 @@ OptimizationOutcome optimize_design(const OptimizationProblem& p, const fs::path
   Callback objective = [&](const std::vector<double>& x) { return objective_of(finished_case(x)); };
   Callback constraint = [&](const std::vector<double>& x) { return p.groove_fill_at_least - finished_case(x).groove_fill; };  // <= 0: fills enough
   if (p.method == "toms748") {
-    // Boost.Math's TOMS 748: the target's sign change between the bounds is kept and shrunk (interpolation steps,
-    // bisection where they stall) until the bracket is narrower than twice the variable's tolerance.
     const OptimizedVariable& x = p.variables.front();
-    struct CloseEnough {};
-    auto f = [&](double at) {
+    const auto miss = [&](double at) {
       const CaseResult& r = evaluate({at});
       if (r.status != "finished") {
         stop_reason = fmt::format("{} {}: {}", r.name, r.status, r.reason);
         throw nlopt::forced_stop();
       }
-      const double miss = r.deflection_mm - p.target_deflection_mm;
-      if (std::isfinite(p.deflection_tolerance_mm) && std::abs(miss) <= p.deflection_tolerance_mm) throw CloseEnough{};
-      return miss;
+      return r.deflection_mm - p.target_deflection_mm;
     };
     try {
-      const double f_min = f(x.min), f_max = f(x.max);
-      if ((f_min < 0) == (f_max < 0)) {
-        outcome.stop_reason = fmt::format("the deflection does not reach the target between the bounds ({:+.4f} mm at {:g}, {:+.4f} mm at {:g})",
-                                          f_min + p.target_deflection_mm, x.min, f_max + p.target_deflection_mm, x.max);
-      } else {
-        boost::uintmax_t iterations = static_cast<boost::uintmax_t>(std::max(1, p.max_evaluations - 2));
-        const auto bracket = boost::math::tools::toms748_solve(f, x.min, x.max, f_min, f_max,
-                                                                [&](double a, double b) { return std::abs(b - a) <= 2 * x.tolerance; }, iterations);
-        const bool narrow = std::abs(bracket.second - bracket.first) <= 2 * x.tolerance;
-        outcome.converged = narrow;
-        outcome.stop_reason = narrow ? fmt::format("the target lies between {} = {:.5g} and {:.5g}", x.name, bracket.first, bracket.second)
-                                     : fmt::format("max_evaluations reached with the target between {:.5g} and {:.5g}", bracket.first, bracket.second);
-        outcome.bracket = {bracket.first, bracket.second};
-      }
-    } catch (const CloseEnough&) {
-      outcome.converged = true;
-      outcome.stop_reason = "the deflection is within its tolerance of the target";
+      const TargetBracket found = bracket_target(miss, x.name, x.min, x.max, x.tolerance, p.deflection_tolerance_mm, p.max_evaluations);
+      outcome.converged = found.converged;
+      outcome.stop_reason = found.stop_reason;
+      if (std::isfinite(found.from)) outcome.bracket = {found.from, found.to};
     } catch (const nlopt::forced_stop&) {
       outcome.stop_reason = "an evaluation did not finish: " + stop_reason;
     }

@@ -383,7 +383,7 @@ TEST_CASE("needle run --tissue-entry-x-mm: the block starts there, the rod meets
   }
 }
 
-TEST_CASE("tissue.contact.lip_release_mode: crushed by default, free or off on request; SB has no lip; bad input is refused",
+TEST_CASE("tissue.contact.lip_release_mode: crushed by default, free or off on request, SB has no lip, bad input is refused",
           "[apps][lspg][gmsh][lip][slow]") {
   // HMB's tip point sits 0.80 mm above the rod's bottom: pushed 0.8 mm into the small block (0.4 mm particles), the particles
   // the tip passes below A inside the rod's outline are crushed by default (bonds kept), cut loose when free (every bond

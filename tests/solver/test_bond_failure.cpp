@@ -110,7 +110,7 @@ TEST_CASE("A notched bar pulled apart separates at the bond-failure strain", "[s
   for (const auto& x : p.position_mm) CHECK(x.allFinite());
 }
 
-TEST_CASE("Cut bonds separate their particles; squeezed crack-face particles detach, intact ones do not", "[solver][failure]") {
+TEST_CASE("Cut bonds separate their particles, squeezed crack-face particles detach, intact ones do not", "[solver][failure]") {
   // Cut every bond across the plane x = 1.1 of a 2 mm cube (cut_bonds, as the needle does), then squeeze
   // the whole block to a fifth of its volume. The particles with a cut bond are on a crack face: below
   // crack_face_min_volume_ratio they stop being integration points. The others are intact and stay.

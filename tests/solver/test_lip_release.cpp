@@ -97,7 +97,7 @@ TEST_CASE("The lip release takes the particles below tip point A, inside the rod
   }
 }
 
-TEST_CASE("Released particles lose every bond and carry no stress; mass and the internal forces' zero sum are kept", "[solver][lip]") {
+TEST_CASE("Released particles lose every bond and carry no stress, mass and the internal forces' zero sum are kept", "[solver][lip]") {
   // A 2 x 1.2 x 1 mm block at 0.2 mm, squeezed 10 % in y about its centre, with tip point A at (1.05, 0.05, 0).
   ParticleSet set = needle_test::free_box({0, -0.6, 0}, {2, 0.6, 1}, 0.2);
   TissueMaterial material;

@@ -39,7 +39,7 @@ struct PointLoad : NeedleLoads {
 
 }  // namespace
 
-TEST_CASE("Needle models are made by name; an unknown name lists the known ones", "[solver][needle]") {
+TEST_CASE("Needle models are made by name, an unknown name lists the known ones", "[solver][needle]") {
   const FeNeedle needle(rod(), NeedleMaterial{}, 0.0);
   InsertionProfile profile;
   profile.accel_time_ms = 0.01;

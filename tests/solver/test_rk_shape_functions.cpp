@@ -103,7 +103,7 @@ TEST_CASE("RK gradients are the derivatives of the shape functions", "[solver][r
   CHECK(gap.first < 1e-6 * gap.second);
 }
 
-TEST_CASE("Rows rebuilt without cut entries keep reproduction; too few entries invalidate a row", "[solver][rk]") {
+TEST_CASE("Rows rebuilt without cut entries keep reproduction, too few entries invalidate a row", "[solver][rk]") {
   const ParticleSet set = needle_test::free_box({0, 0, 0}, {3, 3, 3}, 0.5);
   const Eigen::VectorXd r = radii(set, 1.8);
   RkShapeFunctions rk = build_rk_shape_functions(set.x_mm, r);

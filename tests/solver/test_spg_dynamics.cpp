@@ -96,7 +96,7 @@ TEST_CASE("An undamped elastic vibration keeps its energy over ten periods", "[s
   CHECK(std::abs(ke_peak_last_period / ke0 - 1) < 0.01);
 }
 
-TEST_CASE("The odd-even mode costs no energy under nodal integration; smoothing gives it stiffness", "[solver][dynamics]") {
+TEST_CASE("The odd-even mode costs no energy under nodal integration, smoothing gives it stiffness", "[solver][dynamics]") {
   // On a regular lattice the RK gradients at a particle are odd in the neighbour offset, so the
   // odd-even pattern (-1)^(i+j+k) has exactly zero strain at every particle whose stencil is complete:
   // a zero-energy mode that nothing restores. Smoothing must push it back.

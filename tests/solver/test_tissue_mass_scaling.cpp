@@ -71,7 +71,7 @@ double quarter_period_ms(double target_dt_ms) {
 
 }  // namespace
 
-TEST_CASE("A squeezed particle gets mass m0 (dt/dt_i)^2 with its momentum; released, its physical mass with its velocity",
+TEST_CASE("A squeezed particle gets mass m0 (dt/dt_i)^2 with its momentum, released, its physical mass with its velocity",
           "[solver][spg][dynamics]") {
   SpgTissue tissue(needle_test::free_box({0, 0, 0}, {2, 2, 2}, 0.5), elastic_card(), SpgOptions{});
   TissueParticles& p = tissue.particles();
