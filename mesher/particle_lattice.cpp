@@ -170,6 +170,12 @@ std::string face_condition_name(FaceCondition condition) {
   return "?";
 }
 
+double lattice_particle_bound(const Eigen::Vector3d& extent_mm, double spacing_mm, int refinement) {
+  double bound = 1;
+  for (int k = 0; k < 3; ++k) bound *= extent_mm[k] / spacing_mm * refinement + 1;
+  return bound;
+}
+
 ParticleSet make_particle_lattice(const TissueBox& box, const LatticeOptions& options) {
   const double h = options.spacing_mm;
   NEEDLE_REQUIRE(std::isfinite(h) && h > 0, fmt::format("particle spacing must be a positive length in mm (got {})", h));
@@ -189,9 +195,8 @@ ParticleSet make_particle_lattice(const TissueBox& box, const LatticeOptions& op
       NEEDLE_REQUIRE(r.min_mm[k] < r.max_mm[k] && r.min_mm[k] < box.max_mm[k] && r.max_mm[k] > box.min_mm[k],
                      fmt::format("the region of interest does not overlap the tissue box along {}", "xyz"[k]));
   }
-  double estimate = 1;
-  for (int k = 0; k < 3; ++k) estimate *= (box.max_mm[k] - box.min_mm[k]) / h * refinement + 1;
-  NEEDLE_REQUIRE(estimate < 5e7, fmt::format("spacing {} mm would make about {:.3g} particles (limit 5e7)", h, estimate));
+  const double estimate = lattice_particle_bound(box.max_mm - box.min_mm, h, refinement);
+  NEEDLE_REQUIRE(estimate < kMaxLatticeParticles, fmt::format("spacing {} mm would make about {:.3g} particles (limit {:.0e})", h, estimate, kMaxLatticeParticles));
 
   if (options.region_of_interest && options.region_of_interest->grading == LatticeGrading::nested && refinement > 1)
     return nested_lattice(box, h, *options.region_of_interest);

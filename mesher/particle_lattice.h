@@ -73,8 +73,14 @@ struct ParticleSet {
 };
 
 // InputError for an empty box, a spacing that is not positive or leaves fewer than one interval
-// across an axis, a lattice over 5e7 particles, or a region of interest outside the box.
+// across an axis, a lattice over kMaxLatticeParticles, or a region of interest outside the box.
 ParticleSet make_particle_lattice(const TissueBox& box, const LatticeOptions& options);
+
+// The most particles a lattice may have, and the bound make_particle_lattice holds it to: a box of these extents at
+// this spacing, refined this many times everywhere (an upper bound for a refined region). The scene reader checks the
+// same bound, so a sweep's pre-run check refuses a spacing that no case could run.
+inline constexpr double kMaxLatticeParticles = 5e7;
+double lattice_particle_bound(const Eigen::Vector3d& extent_mm, double spacing_mm, int refinement);
 
 // Names as used in scene files and reports.
 FaceCondition face_condition_from_name(const std::string& name);

@@ -124,6 +124,14 @@ void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc) {
   t.path_refinement = o.integer("path_refinement", t.path_refinement, 1, 8);
   t.path_half_width_mm = o.quantity("path_half_width", Dimension::length, t.path_half_width_mm, positive());
   {
+    const double bound = lattice_particle_bound(t.size_mm, t.spacing_mm, t.path_refinement);
+    NEEDLE_REQUIRE(bound < kMaxLatticeParticles,
+                   fmt::format("{}: {} mm particles (refined {} times near the path) in a block of {} x {} x {} mm would make up to {:.3g} "
+                               "particles (limit {:.0e})",
+                               o.where("spacing_mm"), t.spacing_mm, t.path_refinement, t.size_mm.x(), t.size_mm.y(), t.size_mm.z(), bound,
+                               kMaxLatticeParticles));
+  }
+  {
     const std::string grading = o.text("path_grading", lattice_grading_name(t.path_grading));
     try {
       t.path_grading = lattice_grading_from_name(grading);

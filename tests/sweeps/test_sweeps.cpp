@@ -341,6 +341,8 @@ TEST_CASE("Bad sweep and optimisation files get one clear error before any case 
       {R"({"base": {"scene": "scene.json"}, "variables": {"tissue.friction": [0.1, 0.2, 0.1]}})", "'tissue.friction' lists 0.1 twice"},
       {R"({"base": {"scene": "scene.json", "preset": "SB"}, "variables": {"d_a_mm": [0, 0.1]}})",
        "a 'd_a_mm' variable grinds the paper's multi-bevel tips, which would replace the base's preset SB"},
+      // A spacing no case could run is the scene reader's to refuse, before any case, as `run --set` does (issue 51).
+      {R"({"base": {"scene": "scene.json"}, "variables": {"tissue.spacing_mm": [0.4, 1e-5]}})", "would make up to"},
   };
   for (const auto& [text, message] : sweeps) {
     write(dir / "bad.json", text);
