@@ -64,7 +64,7 @@ double segment_triangle(const Eigen::Vector3d& a, const Eigen::Vector3d& d, doub
 
 }  // namespace
 
-NeedleBondCut::NeedleBondCut(const ContactSurface& surface) : surface_(surface) {}
+NeedleBondCut::NeedleBondCut(const ContactSurface& surface, double candidate_margin_mm) : surface_(surface), margin_mm_(candidate_margin_mm) {}
 
 NeedleBondCut::Grid NeedleBondCut::build_grid(const Eigen::MatrixX3d& needle_x) const {
   Grid grid;
@@ -187,50 +187,93 @@ std::vector<double> NeedleBondCut::surface_crossings(const Eigen::Vector3d& a, c
   return crossings(build_grid(needle_x), a, b);
 }
 
-std::vector<std::int64_t> NeedleBondCut::bonds_through_needle(const BondNetwork& bonds, const std::vector<Vec3d>& x,
-                                                              const Eigen::MatrixX3d& needle_x) const {
-  const Grid grid = build_grid(needle_x);
-  // Each particle's side of the grid's box along each axis (bit 2k: below it on axis k, bit 2k + 1: above), once
-  // a step: a segment whose two ends share a bit lies wholly on that side, which is for_each_hit's first test
-  // (so the same bonds are found). Most bonds of the block are so, and are then rejected without their positions.
+namespace {
+
+// Each particle's side of the box [lo, hi] along each axis (bit 2k: below it on axis k, bit 2k + 1: above): a segment
+// whose two ends share a bit lies wholly on that side, which is for_each_hit's first test.
+std::vector<std::uint8_t> box_sides(const std::vector<Vec3d>& x, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
   std::vector<std::uint8_t> side(x.size());
   parallel_for(static_cast<std::int64_t>(x.size()), [&](std::int64_t begin, std::int64_t end) {
     for (std::int64_t i = begin; i < end; ++i) {
       const Vec3d& p = x[static_cast<size_t>(i)];
       std::uint8_t bits = 0;
       for (int k = 0; k < 3; ++k) {
-        if (p[k] < grid.lo[k]) bits |= static_cast<std::uint8_t>(1 << (2 * k));
-        if (p[k] > grid.hi[k]) bits |= static_cast<std::uint8_t>(2 << (2 * k));
+        if (p[k] < lo[k]) bits |= static_cast<std::uint8_t>(1 << (2 * k));
+        if (p[k] > hi[k]) bits |= static_cast<std::uint8_t>(2 << (2 * k));
       }
       side[static_cast<size_t>(i)] = bits;
     }
   });
-  // The scan over the compact pair list that select_intact_bonds makes, with the arrays read through local
-  // pointers: the compiler cannot tell that appending a find leaves the lists' addresses be, so it would reload
-  // them for every pair.
-  return parallel_collect_chunks<std::int64_t>(
-      static_cast<std::int64_t>(bonds.intact.size()), [&](std::int64_t begin, std::int64_t end, std::vector<std::int64_t>& found) {
-        const IntactPair* const pairs = bonds.intact.data();
-        const Bond* const all = bonds.bonds.data();
-        const std::uint8_t* const sides = side.data();
-        const Vec3d* const positions = x.data();
-        for (std::int64_t k = begin; k < end; ++k) {
-          const IntactPair pair = pairs[k];
-          if (sides[pair.i] & sides[pair.j]) continue;
-          if (!all[pair.bond].broken && passes_through(grid, positions[pair.i], positions[pair.j])) found.push_back(pair.bond);
-        }
-      });
+  return side;
+}
+
+}  // namespace
+
+std::vector<std::int64_t> NeedleBondCut::scan(const Grid& grid, const IntactPair* pairs, std::int64_t count, const BondNetwork& bonds,
+                                              const std::vector<Vec3d>& x) const {
+  // Most bonds are rejected by their sides alone, without their positions.
+  const std::vector<std::uint8_t> side = box_sides(x, grid.lo, grid.hi);
+  // The arrays are read through local pointers: the compiler cannot tell that appending a find leaves the lists'
+  // addresses be, so it would reload them for every pair.
+  return parallel_collect_chunks<std::int64_t>(count, [&](std::int64_t begin, std::int64_t end, std::vector<std::int64_t>& found) {
+    const Bond* const all = bonds.bonds.data();
+    const std::uint8_t* const sides = side.data();
+    const Vec3d* const positions = x.data();
+    for (std::int64_t k = begin; k < end; ++k) {
+      const IntactPair pair = pairs[k];
+      if (sides[pair.i] & sides[pair.j]) continue;
+      if (!all[pair.bond].broken && passes_through(grid, positions[pair.i], positions[pair.j])) found.push_back(pair.bond);
+    }
+  });
+}
+
+std::vector<std::int64_t> NeedleBondCut::bonds_through_needle(const BondNetwork& bonds, const std::vector<Vec3d>& x,
+                                                              const Eigen::MatrixX3d& needle_x) const {
+  const Grid grid = build_grid(needle_x);
+  return scan(grid, bonds.intact.data(), static_cast<std::int64_t>(bonds.intact.size()), bonds, x);
+}
+
+std::vector<std::int64_t> NeedleBondCut::bonds_through_needle_tracked(const BondNetwork& bonds, const std::vector<Vec3d>& x,
+                                                                      const Eigen::MatrixX3d& needle_x) {
+  const Grid grid = build_grid(needle_x);
+  if (!(margin_mm_ > 0)) return scan(grid, bonds.intact.data(), static_cast<std::int64_t>(bonds.intact.size()), bonds, x);
+  // The list holds every bond the step could cut while the box lies within the listed box widened by half the margin
+  // and no particle has moved half the margin along an axis: a bond left off had both ends beyond the listed box
+  // widened by the whole margin, on one side, and so both still lie beyond the current box on that side.
+  const double half = 0.5 * margin_mm_;
+  bool valid = listed_ && listed_x_.size() == x.size() && (grid.lo.array() >= list_lo_.array() + half).all() &&
+               (grid.hi.array() <= list_hi_.array() - half).all();
+  for (size_t i = 0; valid && i < x.size(); ++i) valid = (x[i] - listed_x_[i]).cwiseAbs().maxCoeff() < half;
+  if (!valid) {
+    list_lo_ = grid.lo.array() - margin_mm_;
+    list_hi_ = grid.hi.array() + margin_mm_;
+    const std::vector<std::uint8_t> side = box_sides(x, list_lo_, list_hi_);
+    const IntactPair* const pairs = bonds.intact.data();
+    const Bond* const all = bonds.bonds.data();
+    candidates_ = parallel_collect_chunks<IntactPair>(static_cast<std::int64_t>(bonds.intact.size()),
+                                                      [&](std::int64_t begin, std::int64_t end, std::vector<IntactPair>& found) {
+                                                        for (std::int64_t k = begin; k < end; ++k) {
+                                                          const IntactPair pair = pairs[k];
+                                                          if (!(side[pair.i] & side[pair.j]) && !all[pair.bond].broken) found.push_back(pair);
+                                                        }
+                                                      });
+    listed_x_ = x;
+    listed_ = true;
+    ++lists_made_;
+  }
+  return scan(grid, candidates_.data(), static_cast<std::int64_t>(candidates_.size()), bonds, x);
 }
 
 void NeedleBondCut::apply(SpgTissue& tissue, const NeedleModel& needle) {
   const auto start = std::chrono::steady_clock::now();
-  cut_ += tissue.cut_bonds(bonds_through_needle(tissue.bonds(), tissue.particles().position_mm, needle.positions_mm()));
+  cut_ += tissue.cut_bonds(bonds_through_needle_tracked(tissue.bonds(), tissue.particles().position_mm, needle.positions_mm()));
   wall_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 void NeedleBondCut::add_summary(nlohmann::json& summary, const SpgTissue&) const {
   summary["bonds_cut_by_needle"] = cut_;
   summary["bond_cut_s"] = wall_s_;
+  summary["bond_cut_candidate_lists"] = lists_made_;
 }
 
 }  // namespace needle

@@ -123,3 +123,54 @@ TEST_CASE("The bonds through the rod are those whose segment dips into the cylin
   CHECK(expected > 20);
   CHECK(mismatched == 0);
 }
+
+TEST_CASE("The candidate list cuts the same bonds, in the same order, as a scan of every intact bond", "[solver][bond_cut][gmsh][slow]") {
+  // The rod pushed 2 mm into a block ahead of its tip, 0.04 mm a step, while the particles wander (up to 0.006 mm a
+  // step along each axis, a seeded sequence): each step the tracked search and the full scan must find the same list;
+  // the bonds found are then broken, as a run breaks them.
+  const TetMesh mesh = rod_mesh(true);
+  const ContactSurface surface(mesh);
+  NeedleBondCut tracked(surface), full(surface, 0.0);
+  TissueBox box;
+  box.min_mm = {0.1, -1.2, 0.0};
+  box.max_mm = {2.5, 1.2, 1.2};
+  box.faces.fill(FaceCondition::free);
+  box.faces[4] = FaceCondition::symmetry;
+  LatticeOptions lattice;
+  lattice.spacing_mm = 0.2;
+  ParticleSet particles = make_particle_lattice(box, lattice);
+  for (Eigen::Index i = 0; i < particles.x_mm.rows(); ++i) particles.x_mm(i, 1) += 0.021;  // none on the rod's axis plane
+  SpgOptions spg;
+  spg.dilation = 4.0;
+  const SpgTissue tissue(particles, TissueMaterial{}, spg);
+  BondNetwork bonds = tissue.bonds();
+  std::vector<Vec3d> x = tissue.particles().position_mm;
+  std::uint64_t state = 12345;
+  const auto wander = [&state] {  // in [-0.006, 0.006] mm
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return (static_cast<double>(state >> 11) / 9007199254740992.0 - 0.5) * 0.012;
+  };
+  std::int64_t cut = 0;
+  const int steps = 50;
+  for (int step = 1; step <= steps; ++step) {
+    Eigen::MatrixX3d needle_x = mesh.X;
+    needle_x.col(0).array() += 0.04 * step;
+    for (Vec3d& p : x)
+      for (int k = 0; k < 3; ++k) p[k] += wander();
+    const std::vector<std::int64_t> a = tracked.bonds_through_needle_tracked(bonds, x, needle_x);
+    const std::vector<std::int64_t> b = full.bonds_through_needle_tracked(bonds, x, needle_x);
+    INFO("step " << step);
+    REQUIRE(a == b);
+    CHECK(b == full.bonds_through_needle(bonds, x, needle_x));
+    for (std::int64_t bond : a) bonds.mark_broken(bond);
+    cut += static_cast<std::int64_t>(a.size());
+  }
+  INFO(cut << " bonds cut; candidate lists made " << tracked.candidate_lists_made() << " times, the last of " << tracked.candidates()
+            << " pairs of " << bonds.intact.size());
+  CHECK(cut > 100);
+  // The list is made again only now and then (the tip's advance of 0.2 mm crosses half the margin every 5 steps), and
+  // holds fewer pairs than the block's intact bonds.
+  CHECK(tracked.candidate_lists_made() >= 2);
+  CHECK(tracked.candidate_lists_made() <= steps / 3);
+  CHECK(tracked.candidates() < bonds.intact.size());
+}
