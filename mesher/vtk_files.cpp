@@ -19,7 +19,7 @@ template <class Body>
 void write_atomically(const std::string& path, const std::string& extension, Body body) {
   NEEDLE_REQUIRE(fs::path(path).extension() == extension, fmt::format("'{}' must end in {}", path, extension));
   write_file_atomically(path, [&](const std::string& scratch_path) {
-    std::ofstream out(scratch_path);
+    std::ofstream out(scratch_path, std::ios::binary);
     out.precision(17);
     body(out);
     if (!out) throw std::runtime_error("could not write " + path);
@@ -37,51 +37,50 @@ const char* vtk_type<std::int32_t>() { return "Int32"; }
 template <>
 const char* vtk_type<std::uint8_t>() { return "UInt8"; }
 
-// RFC 4648 base64 of n bytes, padded.
-void write_base64(std::ostream& out, const unsigned char* bytes, size_t n) {
-  static constexpr char kDigits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string text;
-  text.reserve((n + 2) / 3 * 4);
-  for (size_t i = 0; i < n; i += 3) {
-    const unsigned b0 = bytes[i], b1 = i + 1 < n ? bytes[i + 1] : 0u, b2 = i + 2 < n ? bytes[i + 2] : 0u;
-    const unsigned triple = (b0 << 16) | (b1 << 8) | b2;
-    text += kDigits[(triple >> 18) & 63];
-    text += kDigits[(triple >> 12) & 63];
-    text += i + 1 < n ? kDigits[(triple >> 6) & 63] : '=';
-    text += i + 2 < n ? kDigits[triple & 63] : '=';
-  }
-  out << text;
-}
+// The raw bytes of a file's binary arrays, written after its XML in one <AppendedData encoding="raw"> block: each array
+// its byte count (UInt64, the header_type) then its values, found by its offset from the block's first byte after '_'.
+using AppendedData = std::string;
 
-// One DataArray of the given values (row after row), as text or as base64 with its byte count ahead.
+// One DataArray of the given values (row after row): as text, or as a reference into the appended data.
 template <class T>
-void write_array(std::ostream& out, VtkEncoding encoding, const std::string& name, int components, const std::vector<T>& values) {
-  out << fmt::format("        <DataArray type=\"{}\" Name=\"{}\" NumberOfComponents=\"{}\" format=\"{}\">\n", vtk_type<T>(), name,
-                     components, encoding == VtkEncoding::ascii ? "ascii" : "binary");
-  if (encoding == VtkEncoding::ascii) {
+void write_array(std::ostream& out, AppendedData* appended, const std::string& name, int components, const std::vector<T>& values) {
+  if (!appended) {
+    out << fmt::format("        <DataArray type=\"{}\" Name=\"{}\" NumberOfComponents=\"{}\" format=\"ascii\">\n", vtk_type<T>(), name, components);
     for (const T& v : values) out << +v << ' ';  // + prints a UInt8 as a number
-  } else {
-    static_assert(sizeof(double) == 8 && std::numeric_limits<double>::is_iec559, "VTK's Float64 is an IEEE double");
-    const std::uint64_t bytes = values.size() * sizeof(T);  // little-endian machines only (x86-64, aarch64)
-    write_base64(out, reinterpret_cast<const unsigned char*>(&bytes), sizeof bytes);
-    write_base64(out, reinterpret_cast<const unsigned char*>(values.data()), static_cast<size_t>(bytes));
+    out << "\n        </DataArray>\n";
+    return;
   }
-  out << "\n        </DataArray>\n";
+  static_assert(sizeof(double) == 8 && std::numeric_limits<double>::is_iec559, "VTK's Float64 is an IEEE double");
+  out << fmt::format("        <DataArray type=\"{}\" Name=\"{}\" NumberOfComponents=\"{}\" format=\"appended\" offset=\"{}\"/>\n", vtk_type<T>(), name,
+                     components, appended->size());
+  const std::uint64_t bytes = values.size() * sizeof(T);  // little-endian machines only (x86-64, aarch64)
+  appended->append(reinterpret_cast<const char*>(&bytes), sizeof bytes);
+  appended->append(reinterpret_cast<const char*>(values.data()), static_cast<size_t>(bytes));
 }
 
-void write_field(std::ostream& out, VtkEncoding encoding, const VtkField& field, int padding_rows) {
+void write_field(std::ostream& out, AppendedData* appended, const VtkField& field, int padding_rows) {
   std::vector<double> values;
   values.reserve(static_cast<size_t>((field.values.rows() + padding_rows) * field.values.cols()));
   for (Eigen::Index r = 0; r < field.values.rows(); ++r)
     for (Eigen::Index c = 0; c < field.values.cols(); ++c) values.push_back(field.values(r, c));
   values.resize(values.size() + static_cast<size_t>(padding_rows * field.values.cols()), 0.0);
-  write_array(out, encoding, field.name, static_cast<int>(field.values.cols()), values);
+  write_array(out, appended, field.name, static_cast<int>(field.values.cols()), values);
 }
 
-void write_points(std::ostream& out, VtkEncoding encoding, const Eigen::MatrixX3d& X) {
+void write_points(std::ostream& out, AppendedData* appended, const Eigen::MatrixX3d& X) {
   out << "      <Points>\n";
-  write_field(out, encoding, VtkField{"position_mm", X}, 0);
+  write_field(out, appended, VtkField{"position_mm", X}, 0);
   out << "      </Points>\n";
+}
+
+// The appended block and the file's end.
+void write_file_end(std::ostream& out, const AppendedData* appended) {
+  if (appended) {
+    out << "  <AppendedData encoding=\"raw\">\n_";
+    out.write(appended->data(), static_cast<std::streamsize>(appended->size()));
+    out << "\n  </AppendedData>\n";
+  }
+  out << "</VTKFile>\n";
 }
 
 std::string file_header(const char* type, VtkEncoding encoding) {
@@ -98,10 +97,12 @@ void write_vtu(const std::string& path, const TetMesh& mesh, const std::vector<V
   for (const VtkField& f : point_fields)
     if (f.values.rows() != mesh.num_nodes()) throw std::logic_error("write_vtu: point field " + f.name + " has the wrong size");
   write_atomically(path, ".vtu", [&](std::ostream& out) {
+    AppendedData data;
+    AppendedData* const appended = encoding == VtkEncoding::binary ? &data : nullptr;
     const int tets = mesh.num_tets(), faces = mesh.num_boundary_faces();
     out << file_header("UnstructuredGrid", encoding) << "  <UnstructuredGrid>\n"
         << fmt::format("    <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">\n", mesh.num_nodes(), tets + faces);
-    write_points(out, encoding, mesh.X);
+    write_points(out, appended, mesh.X);
     out << "      <Cells>\n";
     std::vector<std::int64_t> connectivity, offsets;
     std::vector<std::uint8_t> types;
@@ -118,19 +119,20 @@ void write_vtu(const std::string& path, const TetMesh& mesh, const std::vector<V
       types.push_back(mesh.order == 2 ? 22 : 5);
       tags.push_back(mesh.boundary_tag(f));
     }
-    write_array(out, encoding, "connectivity", 1, connectivity);
-    write_array(out, encoding, "offsets", 1, offsets);
-    write_array(out, encoding, "types", 1, types);
+    write_array(out, appended, "connectivity", 1, connectivity);
+    write_array(out, appended, "offsets", 1, offsets);
+    write_array(out, appended, "types", 1, types);
     out << "      </Cells>\n      <CellData Scalars=\"boundary_tag\">\n";
-    write_array(out, encoding, "boundary_tag", 1, tags);
-    for (const VtkField& f : tet_fields) write_field(out, encoding, f, faces);
+    write_array(out, appended, "boundary_tag", 1, tags);
+    for (const VtkField& f : tet_fields) write_field(out, appended, f, faces);
     out << "      </CellData>\n      <PointData>\n";
-    for (const VtkField& f : point_fields) write_field(out, encoding, f, 0);
+    for (const VtkField& f : point_fields) write_field(out, appended, f, 0);
     out << "      </PointData>\n    </Piece>\n  </UnstructuredGrid>\n";
     // The tag names, so that a reader knows which boundary_tag is which face.
     out << "  <!-- boundary_tag:";
     for (size_t i = 0; i < mesh.tag_names.size(); ++i) out << ' ' << i << '=' << mesh.tag_names[i];
-    out << " -->\n</VTKFile>\n";
+    out << " -->\n";
+    write_file_end(out, appended);
   });
 }
 
@@ -138,21 +140,24 @@ void write_vtp(const std::string& path, const Eigen::MatrixX3d& points, const st
   for (const VtkField& f : point_fields)
     if (f.values.rows() != points.rows()) throw std::logic_error("write_vtp: field " + f.name + " has the wrong size");
   write_atomically(path, ".vtp", [&](std::ostream& out) {
+    AppendedData data;
+    AppendedData* const appended = encoding == VtkEncoding::binary ? &data : nullptr;
     const Eigen::Index n = points.rows();
     out << file_header("PolyData", encoding) << "  <PolyData>\n"
         << fmt::format("    <Piece NumberOfPoints=\"{}\" NumberOfVerts=\"{}\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n", n, n);
-    write_points(out, encoding, points);
+    write_points(out, appended, points);
     out << "      <Verts>\n";
     std::vector<std::int64_t> connectivity(static_cast<size_t>(n)), offsets(static_cast<size_t>(n));
     for (Eigen::Index i = 0; i < n; ++i) {
       connectivity[static_cast<size_t>(i)] = i;
       offsets[static_cast<size_t>(i)] = i + 1;
     }
-    write_array(out, encoding, "connectivity", 1, connectivity);
-    write_array(out, encoding, "offsets", 1, offsets);
+    write_array(out, appended, "connectivity", 1, connectivity);
+    write_array(out, appended, "offsets", 1, offsets);
     out << "      </Verts>\n      <PointData>\n";
-    for (const VtkField& f : point_fields) write_field(out, encoding, f, 0);
-    out << "      </PointData>\n    </Piece>\n  </PolyData>\n</VTKFile>\n";
+    for (const VtkField& f : point_fields) write_field(out, appended, f, 0);
+    out << "      </PointData>\n    </Piece>\n  </PolyData>\n";
+    write_file_end(out, appended);
   });
 }
 

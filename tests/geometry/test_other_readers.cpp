@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <gmsh.h>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -211,5 +212,22 @@ TEST_CASE("VTK and meshio read the binary and the ASCII VTU and VTP files value 
       INFO("value " << i);
       CHECK(read[i] == expected[i]);  // both encodings carry every bit
     }
+  }
+  // The binary files hold their arrays raw, after the XML: each array's bytes once, not base64's four for three.
+  for (const char* file : {"binary.vtu", "binary.vtp"}) {
+    std::ifstream in(dir / file, std::ios::binary);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    INFO(file);
+    CHECK(text.find("<AppendedData encoding=\"raw\">") != std::string::npos);
+    CHECK(text.find("format=\"appended\"") != std::string::npos);
+    CHECK(text.find("format=\"binary\"") == std::string::npos);
+    // The positions' 15 doubles appear as their own bytes.
+    std::string positions;
+    for (Eigen::Index r = 0; r < mesh.X.rows(); ++r)
+      for (int c = 0; c < 3; ++c) {
+        const double v = mesh.X(r, c);
+        positions.append(reinterpret_cast<const char*>(&v), sizeof v);
+      }
+    CHECK(text.find(positions) != std::string::npos);
   }
 }
