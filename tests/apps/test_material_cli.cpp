@@ -29,7 +29,7 @@ TEST_CASE("needle material-test --json prints the curve and its error", "[cli][m
   CHECK(report.at("material").at("rate_law") == "off");
 }
 
-TEST_CASE("needle material-test writes a CSV and a PNG, bad cards fail cleanly", "[cli][material]") {
+TEST_CASE("needle material-test writes a CSV and a PNG, bad cards fail cleanly", "[cli][material][slow]") {
   const fs::path dir = fs::temp_directory_path() / "needle_material_cli";
   fs::remove_all(dir);
   fs::create_directories(dir);

@@ -13,7 +13,7 @@
 namespace fs = std::filesystem;
 using namespace needle_test;
 
-TEST_CASE("needle run --model fast runs the implicit needle with the kinematic contact, bad levels are refused", "[apps][lspg][gmsh]") {
+TEST_CASE("needle run --model fast runs the implicit needle with the kinematic contact, bad levels are refused", "[apps][lspg][gmsh][slow]") {
   const RunFiles fast = run_sb_into_small_block("model_fast", "--model fast");
   CHECK(fast.scene["needle"]["model"] == "implicit");
   CHECK(fast.scene["tissue"]["contact"]["law"] == "projection");

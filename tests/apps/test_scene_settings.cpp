@@ -104,7 +104,7 @@ TEST_CASE("A --set setting touches only its own key and that key's unit spelling
   CHECK(travel.motion.travel_mm == Approx(20.0).epsilon(1e-12));
 }
 
-TEST_CASE("needle run --set and needle simulate --set change the run's scene, a bad key is refused with nothing written", "[apps][lspg][gmsh]") {
+TEST_CASE("needle run --set and needle simulate --set change the run's scene, a bad key is refused with nothing written", "[apps][lspg][gmsh][slow]") {
   const RunFiles set = run_rod_into_small_block("set_nu", "--set tissue.material.nu=0.4 --set tissue.friction=0.3");
   CHECK(set.scene["tissue"]["material"]["nu"].get<double>() == 0.4);
   CHECK(set.scene["tissue"]["friction"].get<double>() == 0.3);

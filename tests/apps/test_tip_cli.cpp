@@ -29,7 +29,7 @@ TEST_CASE("needle tip --preset LMB --json prints the report", "[apps][cli][slow]
   }
 }
 
-TEST_CASE("needle tip --d-a writes every format, bad input writes nothing", "[apps][cli][errors]") {
+TEST_CASE("needle tip --d-a writes every format, bad input writes nothing", "[apps][cli][errors][slow]") {
   const fs::path dir = fs::temp_directory_path() / "needle-cli-test";
   fs::remove_all(dir);
   fs::create_directories(dir);

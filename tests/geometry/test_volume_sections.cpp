@@ -37,7 +37,7 @@ TEST_CASE("volume of a rod with one bevel equals pi R^2 (L - R cot theta)", "[ge
   CHECK(enclosed_volume_mm3(solid.surface) < closed_form);  // inscribed
 }
 
-TEST_CASE("preset volumes within 0.5 % of the smooth solid, half model is half", "[geometry][volume]") {
+TEST_CASE("preset volumes within 0.5 % of the smooth solid, half model is half", "[geometry][volume][slow]") {
   for (const std::string& name : preset_names()) {
     const CadSolid full = build_cad_solid(preset_recipe(name));
     const CadSolid half = build_cad_solid(preset_recipe(name), true);

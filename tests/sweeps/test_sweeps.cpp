@@ -396,7 +396,7 @@ TEST_CASE("Bad sweep and optimisation files get one clear error before any case 
 }
 
 TEST_CASE("needle optimize reaches a deflection target and resumes from its evaluations, a case's tip angles make its recipe",
-          "[sweeps][gmsh][lspg]") {
+          "[sweeps][gmsh][lspg][slow]") {
   const fs::path dir = fresh_folder("optimize");
   write_tiny_scene(dir);
   // The tissue's E that makes the tiny scene's tip deflect 0.018 mm (0.0177 mm at E 0.5, 0.0185 mm at 0.7, with the crushed lip).
