@@ -20,4 +20,11 @@ inline CLI::Validator count_check() {
       "COUNT");
 }
 
+// --allow-other-code, for the commands that run a study's cases into a folder (sweep, optimize, stress): go on with a
+// folder whose cases another build began (sweeps/sweep_plan.h: claim_study_folder).
+inline void add_allow_other_code_flag(CLI::App* command, bool& allow) {
+  command->add_flag("--allow-other-code", allow,
+                    "Go on with a study whose cases another build of needle began (its study_code.txt names it): one table then mixes two codes' results");
+}
+
 }  // namespace needle

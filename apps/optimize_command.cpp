@@ -48,8 +48,7 @@ void add_optimize_command(CLI::App& app) {
   c->add_option("--out", o->out_dir, "The search's folder (created; a folder of the same search goes on where it stopped)")->required();
   c->add_option("--threads", o->threads, "Worker threads of each evaluation (default: all cores)")->check(count_check());
   c->add_flag("--quiet", o->quiet, "No progress lines");
-  c->add_flag("--allow-other-code", o->allow_other_code,
-              "Go on with a study whose cases another build of needle began (its study_code.txt names it): one table then mixes two codes' results");
+  add_allow_other_code_flag(c, o->allow_other_code);
   c->callback([o] { run(*o); });
 }
 

@@ -6,6 +6,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "apps/cli_checks.h"
 #include "core/input_error.h"
 #include "core/parallel.h"
 #include "sweeps/stress_report.h"
@@ -72,8 +73,7 @@ void add_stress_command(CLI::App& app) {
   c->add_option("--jobs", o->jobs, "Worker processes (default 2)");
   c->add_option("--case-time-limit-s", o->case_time_limit_s, "Stop a case that runs longer and record it as timed out (0: the suite's default, 900 s; 120 s with --short)");
   c->add_flag("--quiet", o->quiet, "No progress lines");
-  c->add_flag("--allow-other-code", o->allow_other_code,
-              "Go on with a study whose cases another build of needle began (its study_code.txt names it): one table then mixes two codes' results");
+  add_allow_other_code_flag(c, o->allow_other_code);
   c->callback([o] { run(*o); });
 }
 

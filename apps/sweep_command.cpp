@@ -138,8 +138,7 @@ void add_sweep_command(CLI::App& app) {
   c->add_flag("--collect", o->collect, "Build the table from the cases done in --out (after a batch array)");
   c->add_flag("--count", o->count, "Print the number of cases and exit (for sbatch --array=0-(N-1))");
   c->add_flag("--quiet", o->quiet, "No progress lines");
-  c->add_flag("--allow-other-code", o->allow_other_code,
-              "Go on with a study whose cases another build of needle began (its study_code.txt names it): one table then mixes two codes' results");
+  add_allow_other_code_flag(c, o->allow_other_code);
   c->footer("Exit codes: 0 every case finished (or its tip cannot be ground); 3 the table is written but some cases stopped, timed out, "
             "failed or were not run; 2 bad input; 130 interrupted (the finished cases stay).");
   c->callback([o] { run(*o); });
