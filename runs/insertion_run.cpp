@@ -359,6 +359,8 @@ class InsertionRunModel : public RunModel {
                                         {"max_added_mass_percent", 100 * r.max_added_mass_g / scaling->physical_mass_g()},
                                         {"added_mass_percent_at_end", 100 * r.added_mass_g / scaling->physical_mass_g()},
                                         {"max_mass_ratio", r.max_ratio},
+                                        {"max_added_mass_percent_crushed", 100 * r.max_added_mass_crushed_g / scaling->physical_mass_g()},
+                                        {"max_mass_ratio_crushed", r.max_ratio_crushed},
                                         {"scaled_particles_at_end", r.scaled_particles},
                                         {"kinetic_energy_added_mJ", r.energy_mJ}};
     }

@@ -27,13 +27,17 @@ const std::vector<std::int32_t>& TissueMassScaling::apply(double dt_ms, const Sp
     if (particle_dt_ms_[i] < dt_ms) scaled_now.push_back(static_cast<std::int32_t>(i));
   std::vector<std::int32_t> touched;
   std::set_union(scaled_.begin(), scaled_.end(), scaled_now.begin(), scaled_now.end(), std::back_inserter(touched));
-  double energy = 0, added = 0;
+  double energy = 0, added = 0, added_crushed = 0;
   for (std::int32_t i : touched) {
     const size_t s = static_cast<size_t>(i);
     const double ratio = particle_dt_ms_[s] < dt_ms ? (dt_ms / particle_dt_ms_[s]) * (dt_ms / particle_dt_ms_[s]) : 1.0;
     const double m_new = physical_mass_g_[s] * ratio, m_old = p.mass_g[s];
     added += m_new - physical_mass_g_[s];
     report_.max_ratio = std::max(report_.max_ratio, ratio);
+    if (p.flags[s] & kParticleCrushed) {
+      added_crushed += m_new - physical_mass_g_[s];
+      report_.max_ratio_crushed = std::max(report_.max_ratio_crushed, ratio);
+    }
     if (m_new == m_old) continue;
     Vec3d& v = p.velocity_mm_per_ms[s];
     const double ke_old = 0.5 * m_old * v.squaredNorm();
@@ -48,6 +52,7 @@ const std::vector<std::int32_t>& TissueMassScaling::apply(double dt_ms, const Sp
   report_.scaled_particles = static_cast<std::int64_t>(scaled_.size());
   report_.added_mass_g = added;
   report_.max_added_mass_g = std::max(report_.max_added_mass_g, added);
+  report_.max_added_mass_crushed_g = std::max(report_.max_added_mass_crushed_g, added_crushed);
   report_.energy_mJ += energy;
   return changed_;
 }

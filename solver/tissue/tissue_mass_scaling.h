@@ -24,6 +24,10 @@ struct MassScalingReport {
   double added_mass_g = 0;            // now, over all particles
   double max_added_mass_g = 0;        // the most added at once over the run
   double max_ratio = 1;               // the largest m / m0 over the run
+  // The same two over the crushed particles only (kParticleCrushed, the lip below a tip point): where a
+  // material with no shear stiffness is sheared flat, its step is short and its added mass large.
+  double max_added_mass_crushed_g = 0;
+  double max_ratio_crushed = 1;
   double energy_mJ = 0;               // kinetic energy the mass changes added over the run (<= 0: they remove it)
 };
 
