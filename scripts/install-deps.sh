@@ -8,6 +8,8 @@
 # whichever BLAS Debian's alternative selects (solver/CMakeLists.txt); ATLAS (libatlas3-base) is installed as the other
 # BLAS that tests/apps/test_blas_pin.cpp runs a scene with. Installing it makes ATLAS the system's libblas.so.3 for
 # other programs (numpy, OpenTURNS); needle's results do not move with it. --no-install-recommends keeps the rest lean.
+# Slurm and munge (slurm-wlm, munge) are for the test that runs docs/sweeps.md's Slurm example on a single-node Slurm it
+# starts on localhost (tests/sweeps/slurm_array_test.sh); nothing here starts them as services.
 set -euo pipefail
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
@@ -23,6 +25,7 @@ PACKAGES=(
   libpng-dev libfreetype-dev fonts-dejavu-core
   libsuitesparse-dev libspectra-dev libblas-dev liblapack-dev libatlas3-base
   libnlopt-dev libnlopt-cxx-dev libopenmpi-dev openmpi-bin
+  slurm-wlm munge
   python3-meshio
   python3-openturns python3-matplotlib
   python3-paraview xvfb xauth
