@@ -271,13 +271,17 @@ class InsertionRunModel : public RunModel {
     needle_model_ = make_needle_model(scene.needle.model, {*needle_, driven_base_supports(needle_->mesh(), scene.motion, scene.direction),
                                                            scene.cannula.enabled ? std::optional<CannulaOptions>(scene.cannula) : std::nullopt,
                                                            dynamics});
-    // The tissue's mass scaling to the coupling's own step unless a step is given: the implicit needle's (the
-    // coupling steps are whole multiples of it or fractions), for an explicit needle half the tissue's first.
+    // The tissue's mass scaling target unless a step is given: a quarter of the implicit needle's step (the
+    // coupling steps are whole eighths of it), for an explicit needle half the tissue's first. At the needle's
+    // own step (0.002 ms, the default until 2026-11-27) the crushed lip's particles, sheared flat under HMB's
+    // shaft, were made up to 900 times heavier and held HMB 0.32 mm above the unscaled tissue at 30 mm (SB
+    // 0.05 mm); at a quarter, 0.10 and 0.00 mm, at 2.5-3 times the steps (docs/notebook/lip_release.md).
+    constexpr double kMassScalingTargetPerNeedleStep = 0.25;
     CouplingOptions coupling = scene.solver.coupling;
     if (scene.solver.tissue_mass_scaling || scene.solver.tissue_mass_scaling_dt_ms > 0)
       coupling.tissue_mass_scaling_dt_ms = scene.solver.tissue_mass_scaling_dt_ms > 0 ? scene.solver.tissue_mass_scaling_dt_ms
-                                           : scene.needle.model == "implicit"         ? dynamics.implicit_step_ms
-                                                                                      : 0.5 * tissue_->stable_time_step_ms();
+                                           : scene.needle.model == "implicit" ? kMassScalingTargetPerNeedleStep * dynamics.implicit_step_ms
+                                                                              : 0.5 * tissue_->stable_time_step_ms();
     run_ = std::make_unique<CoupledInsertion>(*needle_model_, *tissue_, *surface_, scene.tissue.contact, std::move(separations), coupling,
                                               cutting);
     tip_ = nearest_node(needle_->mesh(), built_.tip_point);

@@ -12,7 +12,7 @@ const std::vector<ModelLevel>& model_levels() {
        "explicit FE needle subcycled in the tissue's step, frictional penalty contact (the reference)"},
       {"projection", "fe", "projection", false, SupportShape::sphere, "explicit FE needle, kinematic contact: the tissue's own step"},
       {"fast", "implicit", "projection", true, SupportShape::ellipsoid,
-       "implicit linear needle at the coupling step, kinematic contact, tissue mass-scaled to the needle's step: no subcycling; "
+       "implicit linear needle at the coupling step, kinematic contact, tissue mass-scaled where its step is short (to a quarter of the needle's step): no subcycling; "
        "ellipsoidal kernel supports on the graded lattice"},
   };
   return levels;

@@ -90,12 +90,12 @@ std::string describe_run_model(const json& scene, long particles) {
     if (law != "penalty" || (needle_model != "fe" && needle_model != "rigid"))
       d += fmt::format("; the {} needle and the {} contact{}{}{}", needle_model == "implicit" ? "implicit linear" : needle_model,
                        law == "projection" ? "kinematic (projection)" : law,
-                       mass_scaled ? ", the tissue mass-scaled to the needle's step" : "",
+                       mass_scaled ? ", the tissue selectively mass-scaled" : "",
                        ellipsoids ? ", ellipsoidal kernel supports" : "",
                        needle_model == "implicit" && law == "projection" && mass_scaled && ellipsoids ? " (--model fast)" : "");
     else if (mass_scaled || ellipsoids)
-      d += fmt::format("; {}", mass_scaled && ellipsoids ? "the tissue mass-scaled to the needle's step, ellipsoidal kernel supports"
-                                   : mass_scaled    ? "the tissue mass-scaled to the needle's step"
+      d += fmt::format("; {}", mass_scaled && ellipsoids ? "the tissue selectively mass-scaled, ellipsoidal kernel supports"
+                                   : mass_scaled    ? "the tissue selectively mass-scaled"
                                                     : "ellipsoidal kernel supports");
     // No cutting resistance is the default and goes unnamed; a resistance is said.
     const double cutting_MPa = contact.value("cutting_pressure_MPa", 0.0);

@@ -23,10 +23,10 @@ TEST_CASE("needle run --model fast runs the implicit needle with the kinematic c
   CHECK(fast.summary["particles_inside"].get<int>() == 0);
   // One needle step or a few per coupling step, where the explicit needle takes hundreds.
   CHECK(fast.summary["needle_steps"].get<long>() < 4 * fast.summary["steps"].get<long>());
-  // The tissue mass-scaled to the needle's step: the scene says so, the summary gives the target and what was added.
+  // The tissue mass-scaled to a quarter of the needle's step: the scene says so, the summary gives the target and what was added.
   CHECK(fast.scene["solver"]["tissue_mass_scaling"] == true);
   REQUIRE(fast.summary.contains("tissue_mass_scaling"));
-  CHECK(fast.summary["tissue_mass_scaling"]["target_dt_ms"].get<double>() == Approx(fast.summary["needle_time_step_ms"].get<double>()));
+  CHECK(fast.summary["tissue_mass_scaling"]["target_dt_ms"].get<double>() == Approx(0.25 * fast.summary["needle_time_step_ms"].get<double>()));
   CHECK(fast.summary["tissue_mass_scaling"]["max_mass_ratio"].get<double>() >= 1.0);
   CHECK(fast.summary["tissue_mass_scaling"]["kinetic_energy_added_mJ"].get<double>() <= 0.0);
   // Without it (a custom level) the run takes the tissue's own, smaller steps.

@@ -177,8 +177,8 @@ TEST_CASE("needle paper --report-only names the tissue law, the relaxation, the 
                                           "the tissue the tip meets from 0.1 mm below its tip point to 0.4 mm, inside the rod's outline, is cut loose "
                                           "(lip release free); "
                                           "the contact's skin is 0.04 mm and its stiffness factor 10 (the defaults: 0.02 and 30); "
-                                          "the implicit linear needle and the kinematic (projection) contact, the tissue mass-scaled to the "
-                                          "needle's step, ellipsoidal kernel supports (--model fast); "
+                                          "the implicit linear needle and the kinematic (projection) contact, the tissue selectively mass-scaled, "
+                                          "ellipsoidal kernel supports (--model fast); "
                                           "cutting the tissue costs work: a pressure of 0.3 MPa on the tip facets that advance into it; "
                                           "the block's entry face is 0.1 mm ahead of the tip's start (the particle lattice shifted against the "
                                           "path; the tip ends that much less deep); the needle is driven at 4 m/s (the paper's model: 8); the groove starts 5 mm behind the tip point (the presets': 3)") !=
