@@ -272,10 +272,9 @@ class InsertionRunModel : public RunModel {
                                                            scene.cannula.enabled ? std::optional<CannulaOptions>(scene.cannula) : std::nullopt,
                                                            dynamics});
     // The tissue's mass scaling target unless a step is given: a quarter of the implicit needle's step (the
-    // coupling steps are whole eighths of it), for an explicit needle half the tissue's first. At the needle's
-    // own step (0.002 ms, the default until 2026-11-27) the crushed lip's particles, sheared flat under HMB's
-    // shaft, were made up to 900 times heavier and held HMB 0.32 mm above the unscaled tissue at 30 mm (SB
-    // 0.05 mm); at a quarter, 0.10 and 0.00 mm, at 2.5-3 times the steps (docs/notebook/lip_release.md).
+    // coupling steps are whole eighths of it), for an explicit needle half the tissue's first. The quarter is its
+    // measured error at 30 mm: 0.10 mm on HMB, none on SB, where the needle's whole step left 0.32 and 0.05 mm
+    // (the crushed lip's particles made hundreds of times heavier; docs/insertion.md, the mass scaling).
     constexpr double kMassScalingTargetPerNeedleStep = 0.25;
     CouplingOptions coupling = scene.solver.coupling;
     if (scene.solver.tissue_mass_scaling || scene.solver.tissue_mass_scaling_dt_ms > 0)

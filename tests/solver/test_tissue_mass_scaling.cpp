@@ -95,7 +95,10 @@ TEST_CASE("A squeezed particle gets mass m0 (dt/dt_i)^2 with its momentum, relea
   const double ratio = (0.8 / 0.5) * (0.8 / 0.5);
   // Every other particle crushed: the crushed share of the report is theirs alone.
   double physical_crushed = 0;
-  for (size_t s = 0; s < m0.size(); s += 2) p.flags[s] |= kParticleCrushed, physical_crushed += m0[s];
+  for (size_t s = 0; s < m0.size(); s += 2) {
+    p.flags[s] |= kParticleCrushed;
+    physical_crushed += m0[s];
+  }
   CHECK(scaling.apply(0.8 * dt0, tissue, p, free_mask).size() == static_cast<size_t>(p.size()));
   CHECK(scaling.report().max_ratio_crushed == Approx(ratio).epsilon(1e-9));
   CHECK(scaling.report().max_added_mass_crushed_g == Approx((ratio - 1) * physical_crushed).epsilon(1e-9));

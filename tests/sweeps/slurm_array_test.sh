@@ -84,15 +84,7 @@ done
 [ "$state" = idle ] || skip "the node did not come up (state '$state'; $t/slurmd.log)"
 
 # The tiny sweep of tests/sweeps/test_sweeps.cpp: two d_a (and one that cannot be ground) times two frictions.
-cat > "$t/scene.json" << 'EOF'
-{"needle": {"d_a_mm": 0, "length_mm": 26, "mesh": {"order": 1, "size_mm": 0.5}},
- "motion": {"accel_time_ms": 0.02, "travel_mm": 0.8}, "cannula": {"enabled": false},
- "tissue": {"enabled": true, "size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4}, "output": {"frames": 0}}
-EOF
-cat > "$t/sweep.json" << 'EOF'
-{"base": {"scene": "scene.json"}, "model": "fast",
- "variables": {"d_a_mm": {"from": -0.6, "to": 0.4, "count": 3}, "tissue.friction": [0.1, 0.25]}}
-EOF
+cp "$source_dir/tests/data/sweeps/tiny/scene.json" "$source_dir/tests/data/sweeps/tiny/sweep.json" "$t/" || fail "no tests/data/sweeps/tiny"
 n="$("$needle" sweep "$t/sweep.json" --count)" || fail "needle sweep --count"
 [ "$n" = 6 ] || fail "the tiny sweep has $n cases, not 6"
 

@@ -25,18 +25,16 @@ using namespace needle_test;
 
 namespace {
 
-// A 26 mm multi-bevel tip pushed 0.8 mm into the small block, the fast model: a case takes about a second.
-void write_tiny_scene(const fs::path& dir) {
-  write(dir / "scene.json", R"({"needle": {"d_a_mm": 0, "length_mm": 26, "mesh": {"order": 1, "size_mm": 0.5}},)"
-                            R"("motion": {"accel_time_ms": 0.02, "travel_mm": 0.8}, "cannula": {"enabled": false},)"
-                            R"("tissue": {"enabled": true, "size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4}, "output": {"frames": 0}})");
+// The tiny sweep's files (tests/data/sweeps/tiny/, which the Slurm test runs too): a 26 mm multi-bevel tip pushed
+// 0.8 mm into the small block, the fast model, a case about a second; the sweep: two d_a (one beyond the rod: a tip
+// that cannot be ground) and two frictions, 6 cases, 4 of them run.
+void copy_tiny(const fs::path& dir, const char* file) {
+  fs::copy_file(fs::path(NEEDLE_SOURCE_DIR) / "tests/data/sweeps/tiny" / file, dir / file, fs::copy_options::overwrite_existing);
 }
-
-// Two d_a (one beyond the rod: a tip that cannot be ground) and two frictions: 6 cases, 4 of them run.
+void write_tiny_scene(const fs::path& dir) { copy_tiny(dir, "scene.json"); }
 void write_tiny_sweep(const fs::path& dir) {
   write_tiny_scene(dir);
-  write(dir / "sweep.json", R"({"base": {"scene": "scene.json"}, "model": "fast",)"
-                            R"("variables": {"d_a_mm": {"from": -0.6, "to": 0.4, "count": 3}, "tissue.friction": [0.1, 0.25]}})");
+  copy_tiny(dir, "sweep.json");
 }
 
 json read_json(const fs::path& path) {
