@@ -367,6 +367,12 @@ class InsertionRunModel : public RunModel {
                                         {"scaled_particles_at_end", r.scaled_particles},
                                         {"kinetic_energy_added_mJ", r.energy_mJ}};
     }
+    if (const TissueRateLevels* levels = run_->tissue_dynamics().rate_levels())
+      summary["tissue_rate_levels"] = {{"max_level", levels->max_level()},
+                                       {"needle_margin_mm", scene_.solver.coupling.tissue_rate_needle_margin_mm},
+                                       {"safety", levels->safety()},
+                                       {"mean_point_update_share", levels->mean_point_update_share()},
+                                       {"last_point_level_shares", levels->last_point_level_shares()}};
     summary["strain_probes"] = {{"definition", "solver/insertion/strain_probes.h: the smallest principal elastic Hencky strain of the particles "
                                                "touching the top facets (tip_top), touching the tip within 2 mm behind A and no higher than A "
                                                "(below_tip), and inside the groove (groove); median, 5th percentile and minimum"}};

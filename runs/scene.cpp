@@ -222,6 +222,9 @@ void read_solver(SceneObject o, SolverScene& s) {
   c.max_depth_mm = o.quantity("max_contact_depth", Dimension::length, c.max_depth_mm, positive());
   c.tissue_beside_needle = o.boolean("tissue_beside_needle", c.tissue_beside_needle);
   c.tissue_ahead_margin_mm = o.quantity("tissue_ahead_margin", Dimension::length, c.tissue_ahead_margin_mm, non_negative());
+  c.tissue_rate_levels = o.integer("tissue_rate_levels", c.tissue_rate_levels, 0, 10);
+  c.tissue_rate_needle_margin_mm = o.quantity("tissue_rate_needle_margin", Dimension::length, c.tissue_rate_needle_margin_mm, any_finite());
+  c.tissue_rate_safety = o.number("tissue_rate_safety", c.tissue_rate_safety, within(1.0, 1e3));
   o.finish();
 }
 
@@ -331,6 +334,11 @@ json scene_to_json(const Scene& s) {
   if (s.solver.coupling.tissue_beside_needle != defaults.tissue_beside_needle) solver["tissue_beside_needle"] = s.solver.coupling.tissue_beside_needle;
   if (s.solver.coupling.tissue_ahead_margin_mm != defaults.tissue_ahead_margin_mm)
     solver["tissue_ahead_margin_mm"] = s.solver.coupling.tissue_ahead_margin_mm;
+  if (s.solver.coupling.tissue_rate_levels > 0) {  // multi-rate stepping (changes results): written with its margin
+    solver["tissue_rate_levels"] = s.solver.coupling.tissue_rate_levels;
+    solver["tissue_rate_needle_margin_mm"] = s.solver.coupling.tissue_rate_needle_margin_mm;
+    solver["tissue_rate_safety"] = s.solver.coupling.tissue_rate_safety;
+  }
   return {
       {"needle", needle},
       {"motion", motion},

@@ -87,16 +87,22 @@ std::string describe_run_model(const json& scene, long particles) {
     const bool mass_scaled = solver.value("tissue_mass_scaling", false) || solver.value("tissue_mass_scaling_dt_ms", 0.0) > 0;
     // Spherical kernel supports (the full model's) go unnamed; ellipsoids are said.
     const bool ellipsoids = t.contains("spg") && t["spg"].is_object() && t["spg"].value("support", std::string("sphere")) == "ellipsoid";
+    // Multi-rate stepping of the tissue (solver.tissue_rate_levels; one rate goes unnamed).
+    const int rate_levels = solver.value("tissue_rate_levels", 0);
+    const std::string multirate =
+        rate_levels > 0 ? fmt::format(", the tissue away from the needle stepped at up to {} coupling steps (multi-rate)", 1 << rate_levels) : "";
     if (law != "penalty" || (needle_model != "fe" && needle_model != "rigid"))
-      d += fmt::format("; the {} needle and the {} contact{}{}{}", needle_model == "implicit" ? "implicit linear" : needle_model,
+      d += fmt::format("; the {} needle and the {} contact{}{}{}{}", needle_model == "implicit" ? "implicit linear" : needle_model,
                        law == "projection" ? "kinematic (projection)" : law,
                        mass_scaled ? ", the tissue selectively mass-scaled" : "",
-                       ellipsoids ? ", ellipsoidal kernel supports" : "",
-                       needle_model == "implicit" && law == "projection" && mass_scaled && ellipsoids ? " (--model fast)" : "");
-    else if (mass_scaled || ellipsoids)
-      d += fmt::format("; {}", mass_scaled && ellipsoids ? "the tissue selectively mass-scaled, ellipsoidal kernel supports"
-                                   : mass_scaled    ? "the tissue selectively mass-scaled"
-                                                    : "ellipsoidal kernel supports");
+                       ellipsoids ? ", ellipsoidal kernel supports" : "", multirate,
+                       needle_model == "implicit" && law == "projection" && mass_scaled && ellipsoids && rate_levels == 3 ? " (--model fast)" : "");
+    else if (mass_scaled || ellipsoids || !multirate.empty())
+      d += fmt::format("; {}{}", mass_scaled && ellipsoids ? "the tissue selectively mass-scaled, ellipsoidal kernel supports"
+                                 : mass_scaled    ? "the tissue selectively mass-scaled"
+                                 : ellipsoids     ? "ellipsoidal kernel supports"
+                                                  : "",
+                       mass_scaled || ellipsoids ? multirate : multirate.substr(multirate.empty() ? 0 : 2));
     // No cutting resistance is the default and goes unnamed; a resistance is said.
     const double cutting_MPa = contact.value("cutting_pressure_MPa", 0.0);
     if (cutting_MPa > 0)

@@ -21,6 +21,9 @@ void CouplingOptions::validate(const std::string& where) const {
                  fmt::format("{}: tissue_mass_scaling_dt_ms must be zero or positive", where));
   NEEDLE_REQUIRE(std::isfinite(tissue_ahead_margin_mm) && tissue_ahead_margin_mm >= 0,
                  fmt::format("{}: tissue_ahead_margin_mm must be zero or positive", where));
+  NEEDLE_REQUIRE(tissue_rate_levels >= 0 && tissue_rate_levels <= 10, fmt::format("{}: tissue_rate_levels must lie in [0, 10]", where));
+  NEEDLE_REQUIRE(std::isfinite(tissue_rate_needle_margin_mm), fmt::format("{}: tissue_rate_needle_margin_mm must be finite", where));
+  NEEDLE_REQUIRE(std::isfinite(tissue_rate_safety) && tissue_rate_safety >= 1, fmt::format("{}: tissue_rate_safety must be at least 1", where));
 }
 
 CoupledInsertion::CoupledInsertion(NeedleModel& needle, SpgTissue& tissue, const ContactSurface& surface, const ContactOptions& contact,
@@ -40,6 +43,7 @@ CoupledInsertion::CoupledInsertion(NeedleModel& needle, SpgTissue& tissue, const
   NEEDLE_REQUIRE(surface.reference_positions().rows() == needle.positions_mm().rows(), "the contact surface belongs to another needle mesh");
   contact_->set_needle(needle.nodal_mass_g(), needle.time_step_ms());
   tissue_dynamics_.set_mass_scaling(options_.tissue_mass_scaling_dt_ms);
+  tissue_dynamics_.set_rate_levels(options_.tissue_rate_levels, options_.tissue_rate_safety);
   // The contact at t = 0 (particles placed within a penalty's skin already push), on both bodies.
   contact_->begin_step(tissue.particles(), needle.positions_mm(), needle.velocities_mm_per_ms(), 0.0,
                        tissue_dynamics_.time_step_ms(contact_->max_time_step_ms(options_.contact_courant)));
@@ -51,6 +55,7 @@ CoupledInsertion::CoupledInsertion(NeedleModel& needle, SpgTissue& tissue, const
 
 void CoupledInsertion::step(double end_time_ms) {
   const double t = time_ms();
+  if (tissue_dynamics_.at_rate_cycle_start() && options_.tissue_rate_needle_margin_mm >= 0) hold_particles_near_needle_fast();
   const double dt = tissue_dynamics_.kick_and_drift(plan_time_step(end_time_ms));
   contact_->begin_step(tissue_.particles(), needle_.positions_mm(), needle_.velocities_mm_per_ms(), t, dt);
   if (options_.tissue_beside_needle) {
@@ -81,20 +86,30 @@ ContactReport CoupledInsertion::contact() const {
   return report;
 }
 
-void CoupledInsertion::mark_particles_away_from_needle() {
-  const double margin = contact_->options().skin_mm + 2 * needle_motion_mm_ + options_.tissue_ahead_margin_mm;
+void CoupledInsertion::flag_particles_by_needle_box(double margin_mm, bool inside, std::vector<std::uint8_t>& flags) const {
   Eigen::Vector3d lo, hi;
   contact_->surface().closed_bounds(needle_.positions_mm(), lo, hi);
-  lo.array() -= margin;
-  hi.array() += margin;
+  lo.array() -= margin_mm;
+  hi.array() += margin_mm;
   const std::vector<Vec3d>& p = tissue_.particles().position_mm;
-  still_.resize(p.size());
+  flags.resize(p.size());
   parallel_for(static_cast<std::int64_t>(p.size()), [&](std::int64_t begin, std::int64_t end) {
     for (std::int64_t i = begin; i < end; ++i) {
       const Vec3d& q = p[static_cast<size_t>(i)];
-      still_[static_cast<size_t>(i)] = (q.array() < lo.array()).any() || (q.array() > hi.array()).any();
+      const bool outside = (q.array() < lo.array()).any() || (q.array() > hi.array()).any();
+      flags[static_cast<size_t>(i)] = outside != inside;
     }
   });
+}
+
+void CoupledInsertion::mark_particles_away_from_needle() {
+  flag_particles_by_needle_box(contact_->options().skin_mm + 2 * needle_motion_mm_ + options_.tissue_ahead_margin_mm, false, still_);
+}
+
+void CoupledInsertion::hold_particles_near_needle_fast() {
+  std::vector<std::uint8_t> fast;
+  flag_particles_by_needle_box(contact_->options().skin_mm + options_.tissue_rate_needle_margin_mm, true, fast);
+  tissue_dynamics_.set_fast_particles(std::move(fast));
 }
 
 double CoupledInsertion::plan_time_step(double end_time_ms) const {

@@ -51,6 +51,13 @@ struct CouplingOptions {
   // a particle there stops with a SolverError.
   bool tissue_beside_needle = true;
   double tissue_ahead_margin_mm = 0.1;
+  // Multi-rate stepping of the tissue (tissue/tissue_rate_levels.h): the slowest points update every 2^levels
+  // coupling steps (0: every point every step). The particles within this margin of the needle's box (widened by
+  // the contact's skin) are held at the coupling step; negative: none held, the levels follow the particles' own
+  // stable steps alone.
+  int tissue_rate_levels = 0;
+  double tissue_rate_needle_margin_mm = 0.2;
+  double tissue_rate_safety = 1.0;  // a particle's period at most its own stable step over this
   void validate(const std::string& where = "coupling") const;
 };
 
@@ -89,8 +96,13 @@ class CoupledInsertion {
 
  private:
   double plan_time_step(double end_time_ms) const;
+  // One flag per particle: whether it lies inside (inside true) or outside the needle's box (with a half model's
+  // mirror image) widened by margin_mm.
+  void flag_particles_by_needle_box(double margin_mm, bool inside, std::vector<std::uint8_t>& flags) const;
   // Flags the particles away from the needle (CouplingOptions::tissue_beside_needle) into still_.
   void mark_particles_away_from_needle();
+  // Holds the particles near the needle at the coupling step for the next cycle of the rate levels.
+  void hold_particles_near_needle_fast();
   void check_health();  // penetration and the energy balance; SolverError beyond their limits
 
   NeedleModel& needle_;

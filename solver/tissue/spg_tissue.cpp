@@ -206,14 +206,21 @@ std::int64_t SpgTissue::update_points_ahead(double dt_ms, const std::vector<std:
   ahead_.assign(static_cast<size_t>(n), 0);
   still_ = still;
   ahead_dt_ms_ = dt_ms;
+  const std::int64_t rate_step = rate_step_ + 1;
+  const double now_ms = time_ms_ + dt_ms;
   parallel_for(n, [&](std::int64_t begin, std::int64_t end) {
     for (std::int64_t i = begin; i < end; ++i) {
       const size_t s = static_cast<size_t>(i);
-      if (!still[s]) continue;
+      if (!still[s] || !point_due(s, rate_step)) continue;
       bool row_still = true;
       for (std::int64_t e = rk_.offset[s]; e < rk_.offset[s + 1] && row_still; ++e) row_still = still[static_cast<size_t>(rk_.centre[static_cast<size_t>(e)])];
       if (!row_still) continue;
-      update_point(s, dt_ms);
+      if (multirate()) {
+        update_point(s, now_ms - point_time_ms_[s]);
+        point_time_ms_[s] = now_ms;
+      } else {
+        update_point(s, dt_ms);
+      }
       ahead_[s] = 1;
     }
   });
@@ -237,11 +244,25 @@ ForceReport SpgTissue::compute_forces(double dt_ms) {
   // update_points_ahead did).
   const bool ahead = ahead_dt_ms_ >= 0;
   NEEDLE_REQUIRE(!ahead || ahead_dt_ms_ == dt_ms, "compute_forces: the points updated ahead were updated for another step");
+  NEEDLE_REQUIRE(!multirate() || dt_ms > 0, "compute_forces: a multi-rate tissue steps forward (dt > 0)");
   if (!ahead) std::fill(status.begin(), status.end(), std::uint8_t{0});
-  parallel_for(n, [&](std::int64_t begin, std::int64_t end) {
-    for (std::int64_t i = begin; i < end; ++i)
-      if (!ahead || !ahead_[static_cast<size_t>(i)]) update_point(static_cast<size_t>(i), dt_ms);
-  });
+  time_ms_ += dt_ms;
+  const std::int64_t rate_step = multirate() ? ++rate_step_ : 0;
+  if (multirate()) {
+    parallel_for(n, [&](std::int64_t begin, std::int64_t end) {
+      for (std::int64_t i = begin; i < end; ++i) {
+        const size_t s = static_cast<size_t>(i);
+        if (!point_due(s, rate_step) || (ahead && ahead_[s])) continue;
+        update_point(s, time_ms_ - point_time_ms_[s]);
+        point_time_ms_[s] = time_ms_;
+      }
+    });
+  } else {
+    parallel_for(n, [&](std::int64_t begin, std::int64_t end) {
+      for (std::int64_t i = begin; i < end; ++i)
+        if (!ahead || !ahead_[static_cast<size_t>(i)]) update_point(static_cast<size_t>(i), dt_ms);
+    });
+  }
   ahead_dt_ms_ = -1;
   for (std::int64_t i = 0; i < n; ++i)
     if (status[static_cast<size_t>(i)] & kFailed)
@@ -256,8 +277,16 @@ ForceReport SpgTissue::compute_forces(double dt_ms) {
     }
 
   // 2. Forces, gathered per particle through the transpose.
+  parallel_for(n, [&](std::int64_t begin, std::int64_t end) { gather_forces(begin, end, rate_step, false); });
+  if (options_.bond_failure.enabled) report.bonds_broken_now = break_bonds();
+  report.particles_detached_now += detached_on_rebuild_;  // by this evaluation's breaks and cut_bonds since the last
+  detached_on_rebuild_ = 0;
+  return report;
+}
+
+void SpgTissue::gather_forces(std::int64_t begin, std::int64_t end, std::int64_t rate_step, bool all_due) {
   const bool penalty = options_.stabilization == Stabilization::penalty;
-  parallel_for(n, [&](std::int64_t begin, std::int64_t end) {
+  if (!multirate()) {
     for (std::int64_t j = begin; j < end; ++j) {
       const size_t s = static_cast<size_t>(j);
       Vec3d f = penalty ? Vec3d(-stiffness_[s] * defect_[s]) : Vec3d::Zero();
@@ -269,11 +298,85 @@ ForceReport SpgTissue::compute_forces(double dt_ms) {
       }
       p_.force_N[s] = f;
     }
+    return;
+  }
+  // Each due point's share counts 2^level times: the impulse of its period (a point's penalty term on its own
+  // particle is its share too).
+  for (std::int64_t j = begin; j < end; ++j) {
+    const size_t s = static_cast<size_t>(j);
+    Vec3d f = Vec3d::Zero();
+    if (all_due || rate_step % (std::int64_t{1} << gather_level_[s]) == 0) {
+      if (penalty && (all_due || point_due(s, rate_step))) f = -static_cast<double>(std::int64_t{1} << point_level_[s]) * stiffness_[s] * defect_[s];
+      for (std::int64_t c = rk_.column_offset[s]; c < rk_.column_offset[s + 1]; ++c) {
+        const size_t i = static_cast<size_t>(rk_.column_row[static_cast<size_t>(c)]);
+        if (!all_due && !point_due(i, rate_step)) continue;
+        const double weight = static_cast<double>(std::int64_t{1} << point_level_[i]);
+        const std::array<double, 4>& value = rk_.column_value[static_cast<size_t>(c)];  // psi, grad
+        Vec3d share = -(piola_volume_[i] * Vec3d(value[1], value[2], value[3]));
+        if (penalty) share += stiffness_[i] * value[0] * defect_[i];
+        f += weight * share;
+      }
+    }
+    p_.force_N[s] = f;
+  }
+}
+
+void SpgTissue::set_rate_levels(const std::vector<std::uint8_t>& particle_level) {
+  const std::int64_t n = p_.size();
+  NEEDLE_REQUIRE(ahead_dt_ms_ < 0, "set_rate_levels: points were updated ahead for a step not taken yet");
+  NEEDLE_REQUIRE(rate_cycle_complete(), "set_rate_levels: some points lag the tissue's time (the last cycle is not complete)");
+  if (particle_level.empty()) {
+    point_level_.clear();
+    gather_level_.clear();
+    point_time_ms_.clear();
+    parallel_for(n, [&](std::int64_t begin, std::int64_t end) { gather_forces(begin, end, 0, true); });
+    return;
+  }
+  NEEDLE_REQUIRE(particle_level.size() == static_cast<size_t>(n), "set_rate_levels: one level per particle");
+  for (std::uint8_t level : particle_level) NEEDLE_REQUIRE(level < 31, "set_rate_levels: a level above 30");
+  point_level_.resize(static_cast<size_t>(n));
+  gather_level_.resize(static_cast<size_t>(n));
+  parallel_for(n, [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t i = begin; i < end; ++i) {
+      const size_t s = static_cast<size_t>(i);
+      std::uint8_t level = particle_level[s];
+      for (std::int64_t e = rk_.offset[s]; e < rk_.offset[s + 1]; ++e)
+        level = std::min(level, particle_level[static_cast<size_t>(rk_.centre[static_cast<size_t>(e)])]);
+      point_level_[s] = level;
+    }
   });
-  if (options_.bond_failure.enabled) report.bonds_broken_now = break_bonds();
-  report.particles_detached_now += detached_on_rebuild_;  // by this evaluation's breaks and cut_bonds since the last
-  detached_on_rebuild_ = 0;
-  return report;
+  parallel_for(n, [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t j = begin; j < end; ++j) {
+      const size_t s = static_cast<size_t>(j);
+      std::uint8_t level = point_level_[s];
+      for (std::int64_t c = rk_.column_offset[s]; c < rk_.column_offset[s + 1]; ++c)
+        level = std::min(level, point_level_[static_cast<size_t>(rk_.column_row[static_cast<size_t>(c)])]);
+      gather_level_[s] = level;
+    }
+  });
+  point_time_ms_.assign(static_cast<size_t>(n), time_ms_);
+  max_point_level_ = *std::max_element(point_level_.begin(), point_level_.end());
+  rate_step_ = 0;
+  parallel_for(n, [&](std::int64_t begin, std::int64_t end) { gather_forces(begin, end, 0, true); });
+}
+
+bool SpgTissue::rate_cycle_complete() const {
+  return !multirate() || rate_step_ % (std::int64_t{1} << max_point_level_) == 0;
+}
+
+void SpgTissue::catch_up_point(size_t s) {
+  if (!multirate() || point_time_ms_[s] == time_ms_) return;
+  point_status_[s] = 0;
+  update_point(s, time_ms_ - point_time_ms_[s]);
+  point_time_ms_[s] = time_ms_;
+  if (point_status_[s] & kFailed)
+    throw SolverError(fmt::format("particle {} inverted or blew up (det F <= {} or not finite) near x = ({:.3f}, {:.3f}, {:.3f}) mm", s,
+                                  kMinJacobian, p_.position_mm[s].x(), p_.position_mm[s].y(), p_.position_mm[s].z()));
+  if (point_status_[s] & kDetached) {
+    detach(s);
+    ++detached_on_rebuild_;
+  }
+  point_status_[s] = 0;
 }
 
 std::int64_t SpgTissue::break_bonds() {
@@ -370,6 +473,10 @@ std::int64_t SpgTissue::separate(const std::vector<std::pair<std::int64_t, std::
   // that already collapsed once).
   rows.erase(std::remove_if(rows.begin(), rows.end(), [&](std::int64_t i) { return !rk_.valid[static_cast<size_t>(i)]; }), rows.end());
   if (rows.empty()) return count;
+  // Multi-rate: a point between its updates first takes the motion since its last one with its old row.
+  for (std::int64_t i : rows) catch_up_point(static_cast<size_t>(i));
+  rows.erase(std::remove_if(rows.begin(), rows.end(), [&](std::int64_t i) { return !rk_.valid[static_cast<size_t>(i)]; }), rows.end());
+  if (rows.empty()) return count;
   rebuild_rk_rows(rk_, rows, reference_, reference_, p_.supports);
   // The next stress increment must see only motion, not the change of shape functions: restart F there.
   // Every rebuilt row is on a crack face now: where its new support measures a collapsed volume it
@@ -439,7 +546,9 @@ void SpgTissue::apply_filter() {
 }
 
 void SpgTissue::reinitialize_kernel() {
-  // The current configuration becomes the reference; intact bonds only (no healing across cracks).
+  // The current configuration becomes the reference; intact bonds only (no healing across cracks). Multi-rate:
+  // the points between their updates first take the motion since their last one.
+  for (size_t s = 0; s < point_time_ms_.size(); ++s) catch_up_point(s);
   std::unordered_set<std::uint64_t> intact;
   intact.reserve(bonds_.bonds.size() * 2);
   auto key = [](std::int32_t a, std::int32_t b) {

@@ -85,6 +85,21 @@ class SpgTissue {
   // Called by the integrator once per step (counts steps for the filter and the kernel update).
   void end_of_step();
 
+  // Multi-rate (asynchronous) stepping, tissue_rate_levels.h: particle i of level k may take 2^k steps of
+  // compute_forces' dt between its stress updates. A point (a particle as integration point) takes the level of
+  // the fastest particle in its row and is updated every 2^level calls of compute_forces (dt > 0), counted from
+  // this call; its forces on its row then count 2^level times, as the impulse of its whole period (an
+  // asynchronous variational integrator: each point's forces sum to zero, so momentum is kept exactly). Between
+  // its updates a point adds nothing: force_N is then the impulse-weighted force, not the force. Call only when
+  // every point has just been updated (after construction, or when the last cycle is complete:
+  // rate_cycle_complete); it recomputes force_N with the new weights for the step that starts now. An empty
+  // vector returns to one rate.
+  void set_rate_levels(const std::vector<std::uint8_t>& particle_level);
+  bool multirate() const { return !point_level_.empty(); }
+  // Whether every point was updated at the last compute_forces (always true at one rate).
+  bool rate_cycle_complete() const;
+  const std::vector<std::uint8_t>& point_levels() const { return point_level_; }
+
   double stabilization_energy_mJ() const;
   std::int64_t valid_integration_points() const;
   // Whether particle i is still an integration point (false once detached: a free mass point).
@@ -118,6 +133,15 @@ class SpgTissue {
   // an integration point).
   void reset_material_state(size_t s);
   void refresh_reference_matrix();
+  // Multi-rate: whether point s is updated at the rate_step-th compute_forces since the levels were set.
+  bool point_due(size_t s, std::int64_t rate_step) const {
+    return point_level_.empty() || rate_step % (std::int64_t{1} << point_level_[s]) == 0;
+  }
+  // The forces on particles [begin, end) from the points due at rate_step (every point: all_due), each weighted
+  // by 2^its level (at one rate, the plain forces).
+  void gather_forces(std::int64_t begin, std::int64_t end, std::int64_t rate_step, bool all_due);
+  // Multi-rate: updates point s's stress to the tissue's current time if it lags (its row is about to change).
+  void catch_up_point(size_t s);
 
   TissueParticles p_;
   TissueMaterial material_;
@@ -142,6 +166,13 @@ class SpgTissue {
   std::vector<double> shortest_bond_mm_;  // per particle (infinite without bonds)
   std::vector<std::uint8_t> active_;      // break_bonds' scratch: particles whose bonds may break
   std::int64_t detached_on_rebuild_ = 0;  // crack-face particles separate() detached (counted into ForceReport)
+  // Multi-rate state (empty at one rate): each point's level, each particle's fastest point in its column, the
+  // compute_forces calls since the levels were set, the tissue's time and each point's last update.
+  std::vector<std::uint8_t> point_level_, gather_level_;
+  std::int64_t rate_step_ = 0;
+  std::uint8_t max_point_level_ = 0;
+  double time_ms_ = 0;
+  std::vector<double> point_time_ms_;
 };
 
 }  // namespace needle

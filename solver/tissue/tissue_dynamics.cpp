@@ -127,12 +127,25 @@ void TissueDynamics::set_mass_scaling(double target_dt_ms) {
   mass_scaling_ = target_dt_ms > 0 ? std::make_unique<TissueMassScaling>(target_dt_ms, tissue_.particles()) : nullptr;
 }
 
+void TissueDynamics::set_rate_levels(int max_level, double safety) {
+  NEEDLE_REQUIRE(steps_ == 0 && !drifted_, "the tissue's rate levels are set before the first step");
+  rate_levels_ = max_level > 0 ? std::make_unique<TissueRateLevels>(max_level, safety) : nullptr;
+  if (!rate_levels_ && tissue_.multirate()) tissue_.set_rate_levels({});
+}
+
+void TissueDynamics::set_fast_particles(std::vector<std::uint8_t> fast) {
+  NEEDLE_REQUIRE(rate_levels_ != nullptr, "particles are held fast only with rate levels");
+  rate_levels_->set_fast_particles(std::move(fast));
+}
+
 double TissueDynamics::time_step_ms(double max_dt_ms) const {
   const double stable_dt = tissue_.stable_time_step_ms();
   const double first = steps_ == 0 ? stable_dt : first_dt_ms_;
   if (!(stable_dt > 1e-4 * first) || !std::isfinite(stable_dt))
     throw SolverError(fmt::format("the tissue's time step collapsed to {:.3g} ms (first step {:.3g} ms) at t = {:.6g} ms", stable_dt,
                                   first, time_ms_));
+  // Within a cycle of the rate levels the base step may shrink, never grow: the slow points' periods hold.
+  if (rate_levels_ && !at_rate_cycle_start()) max_dt_ms = std::min(max_dt_ms, cycle_dt_ms_);
   return std::min(mass_scaling_ ? mass_scaling_->time_step_ms(stable_dt) : stable_dt, max_dt_ms);
 }
 
@@ -141,8 +154,23 @@ double TissueDynamics::kick_and_drift(double max_dt_ms) {
   TissueParticles& p = tissue_.particles();
   const std::int64_t n = p.size();
   if (steps_ == 0) first_dt_ms_ = tissue_.stable_time_step_ms();
+  const bool cycle_start = at_rate_cycle_start();
   const double dt = time_step_ms(max_dt_ms);
   step_dt_ms_ = dt;
+  if (cycle_start) {
+    // A new cycle of the rate levels: every point was just updated; the levels for this base step, and the
+    // accelerations the step starts from with the new periods' weights.
+    cycle_dt_ms_ = dt;
+    tissue_.set_rate_levels(rate_levels_->levels(tissue_, dt));
+    rate_levels_->record_point_levels(tissue_.point_levels());
+    parallel_for(n, [&](std::int64_t begin, std::int64_t end) {
+      for (std::int64_t i = begin; i < end; ++i) {
+        const size_t s = static_cast<size_t>(i);
+        acceleration_[s] = (p.force_N[s] + external_force_[s]) / p.mass_g[s] + body_acceleration_;
+      }
+    });
+  }
+  if (rate_levels_) rate_levels_->count_step();
   if (mass_scaling_) {
     // Masses for this step's length; momentum kept, the kinetic energy's change booked apart.
     const double before = mass_scaling_->report().energy_mJ;

@@ -19,6 +19,7 @@
 
 #include "solver/tissue/spg_tissue.h"
 #include "solver/tissue/tissue_mass_scaling.h"
+#include "solver/tissue/tissue_rate_levels.h"
 
 namespace needle {
 
@@ -61,6 +62,13 @@ class TissueDynamics {
   // Selective mass scaling to this step (tissue_mass_scaling.h), before the first step; 0: none.
   void set_mass_scaling(double target_dt_ms);
   const TissueMassScaling* mass_scaling() const { return mass_scaling_.get(); }
+  // Multi-rate stepping (tissue_rate_levels.h) with this many levels above the base step, before the first step;
+  // 0: one rate. The forces and force_N are then impulse-weighted (spg_tissue.h).
+  void set_rate_levels(int max_level, double safety = 1.0);
+  const TissueRateLevels* rate_levels() const { return rate_levels_.get(); }
+  // Whether the next step starts a cycle of the rate levels (the fast particles given before it count for it).
+  bool at_rate_cycle_start() const { return rate_levels_ && !drifted_ && tissue_.rate_cycle_complete(); }
+  void set_fast_particles(std::vector<std::uint8_t> fast);
 
   // The step the next step will take: the tissue's stable step (with mass scaling at least its target)
   // capped at max_dt_ms.
@@ -101,6 +109,8 @@ class TissueDynamics {
 
   SpgTissue& tissue_;
   std::unique_ptr<TissueMassScaling> mass_scaling_;
+  std::unique_ptr<TissueRateLevels> rate_levels_;
+  double cycle_dt_ms_ = std::numeric_limits<double>::infinity();  // the base step of the current cycle (multi-rate)
   std::vector<VelocityConstraint> constraints_;
   Eigen::Vector3d body_acceleration_;
   double time_ms_ = 0, first_dt_ms_ = 0, step_dt_ms_ = 0;

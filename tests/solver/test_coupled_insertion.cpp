@@ -506,3 +506,50 @@ TEST_CASE("The tissue's stresses away from the needle, updated beside the needle
     CHECK(nodes[k] == nodes[0]);
   }
 }
+
+TEST_CASE("Multi-rate tissue: a free block hit by the implicit needle exchanges momentum exactly, balances energy, and updates beside "
+          "the needle bit for bit",
+          "[solver][lspg][gmsh][multirate][slow]") {
+  // The coupling step capped at 0.22 of the tissue's stable step, so that the particles away from the needle could
+  // take four of them: their points update every fourth step (tissue_rate_levels 2), those within 0.1 mm of the
+  // needle's box every step. Momentum closes as in the single rate's test above (each point's impulses sum to
+  // zero); the balance within 1 %; and the stresses updated beside the needle's solve give the same bits.
+  const TetMesh mesh = small_needle(short_tip("SB", 6.0), true, 0.5);
+  const InsertionProfile profile = quick_profile(1.5);
+  const double stable = SpgTissue(block(3.0, 1.6, 1.2, 0.4, false), TissueMaterial{}, SpgOptions{}).stable_time_step_ms();
+  std::vector<std::vector<Eigen::Vector3d>> particles;
+  for (const bool beside : {false, true}) {
+    CouplingOptions coupling;
+    coupling.max_step_ms = 0.22 * stable;
+    coupling.tissue_rate_levels = 2;
+    coupling.tissue_rate_needle_margin_mm = 0.1;
+    coupling.tissue_rate_safety = 1.0;
+    coupling.tissue_beside_needle = beside;
+    Insertion ins(mesh, 0.0, {"implicit", 0.25}, profile, Eigen::Vector3d::UnitX(), block(3.0, 1.6, 1.2, 0.4, false), coupling, projection());
+    CoupledInsertion& run = ins.run;
+    int in_contact = 0;
+    double slow_share = 0;
+    while (run.time_ms() < profile.end_time_ms() - 1e-12) {
+      run.step(profile.end_time_ms());
+      in_contact = std::max(in_contact, run.contact().particles_in_contact);
+      slow_share = std::max(slow_share, run.tissue_dynamics().rate_levels()->last_point_level_shares()[2]);
+    }
+    const auto& contact = dynamic_cast<const ProjectionContact&>(run.contact_model());
+    const Eigen::Vector3d tissue_p = run.tissue_momentum();
+    const Eigen::Vector3d balance = tissue_p + run.needle_momentum() - ins.dynamics.drive_impulse_N_ms() + contact.pending_impulse();
+    const double lag = ins.dynamics.time_step_ms() / run.last_step_ms() * contact.pending_impulse().norm();
+    INFO("beside " << beside << ": " << run.steps() << " steps; points at level 2 at most " << slow_share << ", mean share updated a step "
+                   << run.tissue_dynamics().rate_levels()->mean_point_update_share() << "; tissue momentum " << tissue_p.transpose()
+                   << "; imbalance " << balance.transpose() << " (a needle step of the last force: " << lag << ")");
+    CHECK(in_contact > 0);
+    CHECK(slow_share > 0.3);
+    CHECK(run.tissue_dynamics().rate_levels()->mean_point_update_share() < 0.8);
+    CHECK(tissue_p.x() > 0);
+    CHECK(std::abs(balance.x()) <= lag + 1e-9 * tissue_p.norm());
+    CHECK(std::abs(balance.y()) <= lag + 1e-9 * tissue_p.norm());
+    CHECK(run.max_particles_inside() == 0);
+    CHECK(run.energy().balance_error() < 0.01);
+    particles.push_back(ins.tissue.particles().position_mm);
+  }
+  CHECK(particles[1] == particles[0]);
+}
