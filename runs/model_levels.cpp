@@ -8,12 +8,12 @@ namespace needle {
 
 const std::vector<ModelLevel>& model_levels() {
   static const std::vector<ModelLevel> levels = {
-      {"full", "fe", "penalty", false, SupportShape::sphere,
+      {"full", "fe", "penalty", false, SupportShape::sphere, 0,
        "explicit FE needle subcycled in the tissue's step, frictional penalty contact (the reference)"},
-      {"projection", "fe", "projection", false, SupportShape::sphere, "explicit FE needle, kinematic contact: the tissue's own step"},
-      {"fast", "implicit", "projection", true, SupportShape::ellipsoid,
+      {"projection", "fe", "projection", false, SupportShape::sphere, 0, "explicit FE needle, kinematic contact: the tissue's own step"},
+      {"fast", "implicit", "projection", true, SupportShape::ellipsoid, 3,
        "implicit linear needle at the coupling step, kinematic contact, tissue mass-scaled where its step is short (to a quarter of the needle's step): no subcycling; "
-       "ellipsoidal kernel supports on the graded lattice"},
+       "ellipsoidal kernel supports on the graded lattice; the tissue away from the needle at up to 8 coupling steps (multi-rate)"},
   };
   return levels;
 }
@@ -26,6 +26,7 @@ void apply_model_level(Scene& scene, const std::string& name, const std::string&
       scene.tissue.contact.law = level.contact_law;
       scene.solver.tissue_mass_scaling = level.tissue_mass_scaling;
       scene.tissue.spg.support = level.support;
+      scene.solver.coupling.tissue_rate_levels = level.tissue_rate_levels;
       if (!level.tissue_mass_scaling) scene.solver.tissue_mass_scaling_dt_ms = 0;
       return;
     }

@@ -4,11 +4,12 @@
 //   full        the FE needle (explicit, subcycled) and the penalty contact: the reference, the paper's kind of model;
 //   projection  the FE needle and the kinematic contact: the contact no longer sets the step (one lever);
 //   fast        the implicit needle, the kinematic contact and the tissue mass-scaled to a quarter of the needle's step: no
-//               subcycling, and the few particles squeezed under the tip no longer set everybody's step; and
+//               subcycling, and the few particles squeezed under the tip no longer set everybody's step;
 //               ellipsoidal kernel supports, so the graded lattice's coarse particles reach as many neighbours as
-//               the fine ones (solver/tissue/kernel_supports.h).
-// Each level sets needle.model, tissue.contact.law, solver.tissue_mass_scaling and tissue.spg.support; every other
-// key stays the scene's. (The implicit needle needs the kinematic contact: a penalty's force changes within a needle step.)
+//               the fine ones (solver/tissue/kernel_supports.h); and the tissue away from the needle stepped at up to
+//               8 times the coupling step (solver/tissue/tissue_rate_levels.h).
+// Each level sets needle.model, tissue.contact.law, solver.tissue_mass_scaling, tissue.spg.support and
+// solver.tissue_rate_levels; every other key stays the scene's. (The implicit needle needs the kinematic contact: a penalty's force changes within a needle step.)
 #include <string>
 #include <vector>
 
@@ -20,6 +21,7 @@ struct ModelLevel {
   std::string name, needle_model, contact_law;
   bool tissue_mass_scaling = false;
   SupportShape support = SupportShape::sphere;
+  int tissue_rate_levels = 0;  // multi-rate stepping of the tissue (solver.tissue_rate_levels; 0: one rate)
   std::string description;
 };
 
