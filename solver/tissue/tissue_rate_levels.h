@@ -8,7 +8,8 @@
 // asynchronous variational integrator (Lew, Marsden, Ortiz and West 2003) in velocity Verlet form: the base step
 // is velocity Verlet with the impulse-weighted forces, so
 //   - momentum is kept exactly (each point's forces sum to zero over its row, whatever its period);
-//   - at one level it is velocity Verlet, bit for bit (max_level 0 is the plain integrator);
+//   - every point at level 0 it is velocity Verlet (to rounding: the weighted sums run in another order); without
+//     levels (TissueDynamics::set_rate_levels(0), the scene's 0) the integrator is the plain one, bit for bit;
 //   - a point between its updates adds nothing, and the particles drift at their velocities.
 // The levels are set anew every cycle of 2^max_level base steps, when every point has just been updated; within a
 // cycle the base step may shrink (the end time) but not grow. Its error (the far field's stresses sampled
@@ -35,8 +36,7 @@ class TissueRateLevels {
   // Each particle's level for a cycle of base step base_dt_ms, from the tissue's current state.
   const std::vector<std::uint8_t>& levels(const SpgTissue& tissue, double base_dt_ms);
 
-  // Over the cycles so far, weighted by their base steps: the mean share of the points updated in a base step
-  // (1 at one rate), and of the particles held fast by the caller.
+  // Over the base steps so far: the mean share of the points updated in a step (1 at one rate).
   void record_point_levels(const std::vector<std::uint8_t>& point_level);  // the tissue's, once the cycle's levels are set
   void count_step();
   double mean_point_update_share() const { return steps_ > 0 ? update_share_sum_ / static_cast<double>(steps_) : 1.0; }
