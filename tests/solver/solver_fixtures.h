@@ -3,6 +3,7 @@
 #include <random>
 
 #include "mesher/particle_lattice.h"
+#include "solver/tissue/tissue_material.h"
 
 namespace needle_test {
 
@@ -15,6 +16,15 @@ inline needle::ParticleSet free_box(const Eigen::Vector3d& min_mm, const Eigen::
   needle::LatticeOptions options;
   options.spacing_mm = spacing_mm;
   return needle::make_particle_lattice(box, options);
+}
+
+// An elastic card for wave and vibration tests: E 1 MPa, the given nu, no rate effect (yield far away at small strain).
+inline needle::TissueMaterial elastic_card(double nu) {
+  needle::TissueMaterial m;
+  m.E_MPa = 1.0;
+  m.nu = nu;
+  m.rate_law = needle::RateLaw::off;
+  return m;
 }
 
 // The same lattice with every particle moved by up to +-fraction x spacing in each axis (fixed seed).

@@ -12,13 +12,7 @@ using namespace needle;
 
 namespace {
 
-TissueMaterial bar_card(double nu) {
-  TissueMaterial m;
-  m.E_MPa = 1.0;
-  m.nu = nu;
-  m.rate_law = RateLaw::off;
-  return m;
-}
+using needle_test::elastic_card;
 
 std::vector<std::int32_t> layer_at(const TissueParticles& p, double x) {
   std::vector<std::int32_t> layer;
@@ -37,7 +31,7 @@ double mean_vx(const TissueParticles& p, const std::vector<std::int32_t>& layer)
 
 TEST_CASE("A longitudinal pulse travels along a bar at sqrt(E / rho)", "[solver][dynamics]") {
   // nu = 0: the 1-D bar speed sqrt(E / rho) holds in 3-D whatever the cross-section.
-  const TissueMaterial card = bar_card(0.0);
+  const TissueMaterial card = elastic_card(0.0);
   const double c = std::sqrt(card.E_MPa / card.density_g_per_mm3());
   SpgTissue tissue(needle_test::free_box({0, 0, 0}, {40, 2, 2}, 0.5), card, SpgOptions{});
   TissueParticles& p = tissue.particles();
@@ -74,7 +68,7 @@ TEST_CASE("A longitudinal pulse travels along a bar at sqrt(E / rho)", "[solver]
 }
 
 TEST_CASE("An undamped elastic vibration keeps its energy over ten periods", "[solver][dynamics][slow]") {
-  const TissueMaterial card = bar_card(0.3);
+  const TissueMaterial card = elastic_card(0.3);
   const double L = 20.0, c = std::sqrt(card.E_MPa / card.density_g_per_mm3());
   SpgTissue tissue(needle_test::free_box({0, 0, 0}, {L, 2, 2}, 0.5), card, SpgOptions{});
   TissueParticles& p = tissue.particles();
@@ -103,7 +97,7 @@ TEST_CASE("The odd-even mode costs no energy under nodal integration, smoothing 
   auto interior_response = [](Stabilization s, double* defect_after_filter) {
     SpgOptions options;
     options.stabilization = s;
-    SpgTissue tissue(needle_test::free_box({0, 0, 0}, {5, 5, 5}, 0.5), bar_card(0.3), options);
+    SpgTissue tissue(needle_test::free_box({0, 0, 0}, {5, 5, 5}, 0.5), elastic_card(0.3), options);
     TissueParticles& p = tissue.particles();
     const double a = 1e-3;
     std::vector<Eigen::Vector3d> mode(static_cast<size_t>(p.size()));
@@ -135,7 +129,7 @@ TEST_CASE("The odd-even mode costs no energy under nodal integration, smoothing 
     }
     return work / norm;  // N/mm per unit mode amplitude
   };
-  const TissueMaterial card = bar_card(0.3);
+  const TissueMaterial card = elastic_card(0.3);
   const double kappa = 0.1 * card.p_wave_modulus_MPa() * 0.125 / 0.25;  // penalty stiffness of one particle
   const double none = interior_response(Stabilization::none, nullptr);
   const double penalty = interior_response(Stabilization::penalty, nullptr);
@@ -154,7 +148,7 @@ TEST_CASE("A viscoelastic bar's vibration decays at the closed-form loss factor,
   // shear modulus G* = G (1 - g + g i w tau / (1 + i w tau)); the thin bar's modulus E* = 9 K G* / (3 K + G*);
   // its stored-plus-kinetic energy decays as exp(-eta w t), eta = Im E* / Re E*, so the kinetic peak at
   // the end of period 3 is exp(-6 pi eta) of the first.
-  TissueMaterial card = bar_card(0.3);
+  TissueMaterial card = elastic_card(0.3);
   const double L = 20.0;
   const double c = std::sqrt(card.E_MPa / card.density_g_per_mm3());
   const double omega = M_PI * c / L, period = 2 * M_PI / omega;

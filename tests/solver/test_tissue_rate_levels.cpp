@@ -14,13 +14,7 @@ using namespace needle;
 
 namespace {
 
-TissueMaterial elastic_card(double nu) {
-  TissueMaterial m;
-  m.E_MPa = 1.0;
-  m.nu = nu;
-  m.rate_law = RateLaw::off;
-  return m;
-}
+using needle_test::elastic_card;
 
 // The particles with x below x_fast_mm are held at the base step.
 std::vector<std::uint8_t> fast_below(const TissueParticles& p, double x_fast_mm) {
