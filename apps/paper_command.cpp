@@ -33,6 +33,7 @@ namespace {
 struct PaperOptions {
   std::string out_dir, needles = "SB,LMB,AMB,HMB", reference = std::string(NEEDLE_DATA_DIR) + "/paper/reference.json";
   std::string calibration_file;
+  std::string fitted = std::string(NEEDLE_DATA_DIR) + "/paper/crushed_depth_hmb.json";
   std::vector<std::string> compare;  // LABEL=FILE, other reports' results.json
   std::vector<std::string> replicas;  // LABEL=FILE, this model's reports with a numerical detail changed
   std::string label = "this report";  // this report's row among the compared models
@@ -148,6 +149,7 @@ void paper(const PaperOptions& o) {
   report.tissue_E_MPa = scene.tissue.material.E_MPa;
   report.tissue_E_source = E_source;
   report.calibration_path = calibration_file;
+  report.fitted_path = o.fitted;
   report.command_line = o.command_line;
   report.draw_tips = !o.no_tips;
   report.compare = compare;
@@ -169,6 +171,11 @@ void add_paper_command(CLI::App& app) {
   c->add_option("--calibration", o->calibration_file,
                 "calibration.json from `needle calibrate` (its tissue_E_MPa; default: the shipped SB calibration of the model level, "
                 "data/paper/calibration_sb.json for the default)");
+  c->add_option("--fitted", o->fitted,
+                 "The record of the parameter besides E fitted to a needle (default data/paper/crushed_depth_hmb.json, the crushed "
+                 "lip's depth fitted on HMB): where the runs use its value the report names it as fitted, with its "
+                 "leave-one-needle-out errors")
+      ->check(CLI::ExistingFile);
   c->add_option("--reference", o->reference, "The paper's reference table (default data/paper/reference.json)");
   add_scene_override_options(c, o->overrides);
   c->add_option("--mesh-size-mm", o->overrides.mesh_size_mm, "Needle mesh size (run default 0.4)");
@@ -193,6 +200,7 @@ void add_paper_command(CLI::App& app) {
     if (c->count("--tissue-E-MPa")) line += fmt::format(" --tissue-E-MPa {}", o->tissue_E_MPa);
     if (c->count("--calibration")) line += " --calibration " + o->calibration_file;
     if (c->count("--reference")) line += " --reference " + o->reference;
+    if (c->count("--fitted")) line += " --fitted " + o->fitted;
     line += scene_override_arguments(o->overrides);
     if (c->count("--label")) line += fmt::format(" --label \"{}\"", o->label);
     for (const std::string& c : o->compare) line += fmt::format(" --compare \"{}\"", c);

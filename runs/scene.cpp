@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <fmt/format.h>
 
 #include "runs/json_lines.h"
@@ -186,7 +187,15 @@ void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc) {
     t.separation.crack.reach_mm = c.quantity("crack_reach", Dimension::length, t.separation.crack.reach_mm, non_negative());
     t.separation.crack.angles_deg = c.numbers("crack_angles_deg", t.separation.crack.angles_deg, within(-180.0, 180.0));
     t.separation.crack.lead_mm = c.quantity("crack_lead", Dimension::length, t.separation.crack.lead_mm, non_negative());
-    t.separation.lip.depth_mm = c.quantity("lip_release_depth", Dimension::length, t.separation.lip.depth_mm, positive());
+    // The band's depth: a length, or "whole lip" (down to the rod's bottom, however thick the lip).
+    if (c.has("lip_release_depth_mm") && c.raw("lip_release_depth_mm").is_string()) {
+      const std::string depth = c.raw("lip_release_depth_mm").get<std::string>();
+      NEEDLE_REQUIRE(depth == kWholeLipText, fmt::format("{}: give a depth in mm or \"{}\" (got \"{}\")", c.where("lip_release_depth_mm"),
+                                                        kWholeLipText, depth));
+      t.separation.lip.depth_mm = std::numeric_limits<double>::infinity();
+    } else {
+      t.separation.lip.depth_mm = c.quantity("lip_release_depth", Dimension::length, t.separation.lip.depth_mm, positive());
+    }
     t.separation.lip.below_mm = c.quantity("lip_release_below", Dimension::length, t.separation.lip.below_mm, non_negative());
     {
       const std::string mode = c.text("lip_release_mode", lip_release_mode_name(t.separation.lip.mode));
@@ -310,11 +319,14 @@ json scene_to_json(const Scene& s) {
     tissue["contact"]["crack_angles_deg"] = t.separation.crack.angles_deg;
     tissue["contact"]["crack_lead_mm"] = t.separation.crack.lead_mm;
   }
-  // The lip's mode is always written (its default changed on 2026-11-27: a scene says which model made it); the
-  // band's shape only when it is not the whole lip.
+  // The lip's mode is always written (its default changed on 2026-11-27: a scene says which model made it), and so
+  // is a released lip's depth (its default changed on 2026-11-28, from the whole lip to 0.45 mm); the band's top only
+  // when it is not at the tip point.
   tissue["contact"]["lip_release_mode"] = lip_release_mode_name(t.separation.lip.mode);
   if (t.separation.lip.enabled() && t.separation.lip.below_mm != 0) tissue["contact"]["lip_release_below_mm"] = t.separation.lip.below_mm;
-  if (t.separation.lip.enabled() && std::isfinite(t.separation.lip.depth_mm)) tissue["contact"]["lip_release_depth_mm"] = t.separation.lip.depth_mm;
+  if (t.separation.lip.enabled())
+    tissue["contact"]["lip_release_depth_mm"] =
+        std::isfinite(t.separation.lip.depth_mm) ? json(t.separation.lip.depth_mm) : json(kWholeLipText);
   const CannulaOptions& c = s.cannula;
   json motion = {{"accel_time_ms", s.motion.accel_time_ms}, {"speed_m_per_s", s.motion.speed_mm_per_ms}, {"travel_mm", s.motion.travel_mm},
                  {"direction", vector_json(s.direction)}};

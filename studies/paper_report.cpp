@@ -32,6 +32,40 @@ using json = nlohmann::json;
 
 namespace {
 
+// The parameter besides E fitted to a needle, named as fitted, with its leave-one-needle-out errors: when the fitted
+// needle's run here uses the record's value (the record: studies/sensitivity/second_parameter.py --record).
+std::string fitted_parameter_section(const PaperReportInput& in, const fs::path& dir) {
+  if (in.fitted_path.empty() || !fs::is_regular_file(in.fitted_path)) return "";
+  const json record = read_json_file(in.fitted_path, "fitted parameter record");
+  const std::string key = record.value("key", std::string()), needle = record.value("fitted_on", std::string());
+  const double value = record.value("value", kNaN);
+  const fs::path scene_path = dir / "runs" / needle / "scene.json";
+  if (key.empty() || needle.empty() || !std::isfinite(value) || !fs::is_regular_file(scene_path)) return "";
+  std::string pointer;
+  for (size_t start = 0; start <= key.size();) {
+    const size_t end = std::min(key.find('.', start), key.size());
+    pointer += "/" + key.substr(start, end - start);
+    start = end + 1;
+  }
+  const json scene = read_json_file(scene_path.string(), "run scene");
+  const json::json_pointer at(pointer);
+  if (!scene.contains(at) || !scene.at(at).is_number() || scene.at(at).get<double>() != value) return "";
+  std::string md = fmt::format("## One more parameter fitted to a needle: {}, on {} alone\n\n", record.value("name", key), needle);
+  md += fmt::format("`{}` = {:g} {} in these runs is fitted on {} ({:.4g} fitted, rounded; the study: `{}`). {}'s deflection "
+                    "here is therefore a fit, not a prediction, as SB's is through E. Leave one needle out: the value fitted to "
+                    "the other two multi-bevel needles (E calibrated on SB), the held-out needle predicted:\n\n",
+                    key, value, record.value("unit", std::string()), needle, record.value("value_fitted", kNaN),
+                    record.value("study", std::string()), needle);
+  md += "| held out | fitted on | value | predicted (mm) | measured (mm) | error (mm) |\n|---|---|---|---|---|---|\n";
+  for (const json& h : record.value("leave_one_out", json::array()))
+    md += fmt::format("| {} | {} | {:.3g}{} | {:+.3f} | {:+.2f} | {:+.3f} |\n", h.value("held_out", std::string()),
+                      fmt::join(h.value("fitted_on", std::vector<std::string>{}), ", "), h.value("value", kNaN),
+                      h.value("at_range_end", false) ? " (range end)" : "", h.value("prediction_mm", kNaN),
+                      h.value("prediction_mm", kNaN) - h.value("error_mm", kNaN), h.value("error_mm", kNaN));
+  md += "\n";
+  return md;
+}
+
 // What one needle's run folder says.
 struct NeedleRun : NeedleOutcome {
   std::string folder, reason;
@@ -369,6 +403,7 @@ void write_paper_report(const PaperReportInput& in) {
                           "with the same flags before reading the others as predictions.\n\n",
                           r.name, r.deflection_mm, cal_deflection);
   }
+  md += fitted_parameter_section(in, dir);
   md += "## Deflection at the end of insertion (mm, +y up: the groove side)\n\n";
   md += "| needle | d_a (mm) | this toolkit | experiment | LS-DYNA (paper) | ours - experiment | status | run time |\n";
   md += "|---|---|---|---|---|---|---|---|\n";

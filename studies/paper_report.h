@@ -30,6 +30,10 @@ struct PaperReportInput {
   double tissue_E_MPa = 0;
   std::string tissue_E_source;             // how E was chosen (calibration file, flag or default)
   std::string calibration_path;            // calibration.json of `needle calibrate`, if E came from one
+  // The record of a parameter besides E fitted to a needle (data/paper/crushed_depth_hmb.json, written by
+  // studies/sensitivity/second_parameter.py --record): where the fitted needle's run uses its value, the report names the
+  // parameter as fitted and gives its leave-one-needle-out errors. Empty or another value in the runs: no such section.
+  std::string fitted_path;
   std::string command_line;                // to regenerate
   bool draw_tips = true;
   std::vector<ComparedModel> compare;      // other models' results.json, in the order to show

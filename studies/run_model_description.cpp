@@ -59,18 +59,24 @@ std::string describe_run_model(const json& scene, long particles) {
       const double lead_mm = contact.value("crack_lead_mm", 0.0);
       if (lead_mm > 0) d += fmt::format(", running {:g} mm ahead of the tip", lead_mm);
     }
-    // The crushed whole lip is the default and goes unnamed; another lip is said (a scene from before 2026-11-27 has no
-    // mode: the lip then stayed as the tissue is).
+    // The default lip goes unnamed: crushed 0.45 mm deep since 2026-11-28 (a depth fitted on HMB, which the paper report
+    // names in a section of its own). Any other lip is said: a scene of 2026-11-27 or 28 with no depth crushed the whole
+    // lip; a scene from before 2026-11-27 has no mode (the lip stayed as the tissue is).
     const std::string lip_mode = contact.value("lip_release_mode", std::string("off"));
     const double lip_below_mm = contact.value("lip_release_below_mm", 0.0);
-    const bool whole_lip = lip_below_mm == 0 && !contact.contains("lip_release_depth_mm");
+    const json lip_depth = contact.value("lip_release_depth_mm", json(kWholeLipText));
+    const bool whole_lip = lip_depth.is_string();
+    const std::string released = lip_mode == "free" ? "is cut loose (lip release free)" : "is crushed (lip release)";
     if (lip_mode == "off")
       d += "; the lip below the tip point stays as the tissue is (no lip release)";
-    else if (lip_mode != "crushed" || !whole_lip) {
+    else if (lip_mode == "crushed" && lip_below_mm == 0 && !whole_lip && lip_depth.get<double>() == kSceneCrushedLipDepthMm)
+      ;  // the default
+    else if (lip_below_mm == 0 && whole_lip)
+      d += "; the whole lip below the tip point " + released;
+    else {
       d += fmt::format("; the tissue the tip meets from {:g} mm below its tip point", lip_below_mm);
-      d += contact.contains("lip_release_depth_mm") ? fmt::format(" to {:g} mm", lip_below_mm + contact.value("lip_release_depth_mm", 0.0))
-                                                    : std::string(" down to the rod's bottom");
-      d += lip_mode == "free" ? ", inside the rod's outline, is cut loose (lip release free)" : ", inside the rod's outline, is crushed (lip release)";
+      d += whole_lip ? std::string(" down to the rod's bottom") : fmt::format(" to {:g} mm", lip_below_mm + lip_depth.get<double>());
+      d += ", inside the rod's outline, " + released;
     }
     // The default contact (ContactOptions: skin 0.02 mm, stiffness factor 30) goes unnamed; another is said.
     const ContactOptions default_contact;

@@ -118,7 +118,7 @@ void LipRelease::apply(SpgTissue& tissue, const NeedleModel& needle) {
 void LipRelease::add_summary(nlohmann::json& summary, const SpgTissue&) const {
   summary["lip_release"] = {{"mode", lip_release_mode_name(options_.mode)},
                             {"below_mm", options_.below_mm},
-                            {"depth_mm", std::isfinite(options_.depth_mm) ? nlohmann::json(options_.depth_mm) : nlohmann::json("whole lip")},
+                            {"depth_mm", std::isfinite(options_.depth_mm) ? nlohmann::json(options_.depth_mm) : nlohmann::json(kWholeLipText)},
                             {"lip_thickness_mm", lip_thickness_mm()},
                             {"particles_released", released_count_},
                             {"bonds_cut", cut_},

@@ -52,6 +52,7 @@ struct LipReleaseOptions {
 };
 
 constexpr double kNoLipMm = 1e-6;  // a lip thinner than this is none (a tip point on the rod's bottom)
+constexpr const char* kWholeLipText = "whole lip";  // an unbounded depth, as scene files and summaries write it
 
 class LipRelease : public SeparationModel {
  public:

@@ -13,6 +13,7 @@ void SeparationOptions::validate(const std::string& where) const {
 SeparationOptions scene_separation_defaults() {
   SeparationOptions options;
   options.lip.mode = LipReleaseMode::crushed;
+  options.lip.depth_mm = kSceneCrushedLipDepthMm;
   return options;
 }
 

@@ -23,11 +23,19 @@ struct SeparationOptions {
                             // false: only the tissue's failure criterion separates particles
   SymmetrySlitOptions slit;  // the tissue also opens in the symmetry plane behind the tip; off by default
   TipCrackOptions crack;     // the tip drives a crack past the rod's outline; off by default
-  LipReleaseOptions lip;     // the lip below tip point A crushed or cut loose; off here, crushed in a scene
+  LipReleaseOptions lip;     // the lip below tip point A crushed or cut loose; off here, crushed 0.45 mm deep in a scene
   void validate(const std::string& where = "separation") const;  // InputError naming the bad field
 };
 
-// A scene's defaults: SeparationOptions{} with the lip below the tip point crushed (lip_release.h).
+// The depth below tip point A to which a scene crushes the lip (since 2026-11-28). It is fitted to a needle: on HMB
+// alone (the needle whose 0.80 mm lip spans every depth studied), the one parameter besides E that the paper's needles
+// fit; the others are predicted (docs/notebook/crushed_depth.md; the fit's record, with its leave-one-needle-out
+// errors, is data/paper/crushed_depth_hmb.json, and the paper report names it). A lip thinner than this (SB, LMB, AMB)
+// is crushed whole.
+constexpr double kSceneCrushedLipDepthMm = 0.45;
+
+// A scene's defaults: SeparationOptions{} with the lip below the tip point crushed to kSceneCrushedLipDepthMm
+// (lip_release.h).
 SeparationOptions scene_separation_defaults();
 
 // The models options switch on, for the needle whose surface is given (they keep a reference to it).

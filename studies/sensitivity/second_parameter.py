@@ -11,7 +11,14 @@ SB leaves as the prediction, delta_X ~ -1.14 mm x ratio_X):
 
     /usr/bin/python3 studies/sensitivity/second_parameter.py --key needle.groove_start_mm --values 3,4,5,6 --out gs_loo --jobs 2
 
+A key that is a depth into the lip below tip point A (`--lip-depth`, e.g. tissue.contact.lip_release_depth_mm) acts on a
+needle only below that needle's lip thickness: each needle then runs at its own values (`--needle-values HMB=0.2,0.4
+AMB=0.1,0.3`) and once with the key unset (the whole lip), and that run stands for it at every value from its lip
+thickness (the run's summary.json, lip_release.lip_thickness_mm) on; a needle with no values of its own (SB, no lip)
+runs only unset. Between its last value and its lip thickness a needle is interpolated towards the unset run.
+
 Writes into --out: sweep.json and sweep/ (the runs), and second_parameter.json and second_parameter.md (the tables).
+`--runs` analyses sweep folders run elsewhere (several: their cases are read by label).
 """
 import argparse
 import json
@@ -26,32 +33,102 @@ NEEDLES = ["SB", "LMB", "AMB", "HMB"]
 MULTI = ["LMB", "AMB", "HMB"]
 
 
-def sweep_file(key, values, travel_mm):
+DEFAULT = "default"  # the label's value of a case with the key unset (--lip-depth)
+
+
+def sweep_file(key, values, travel_mm, needle_values=None, lip_depth=False):
+    """The cases: every needle at every value; or, with needle_values {needle: [values]}, each needle at its own (a needle
+    left out runs at none), and with lip_depth each needle once more with the key unset."""
     cases = []
-    for v in values:
+    per_needle = needle_values if needle_values is not None else {n: values for n in NEEDLES}
+    if needle_values is None:
+        for v in values:
+            for n in NEEDLES:
+                cases.append({"label": f"{key}={v:g} {n}", "needle.preset": n, key: v})
+    else:
         for n in NEEDLES:
-            cases.append({"label": f"{key}={v:g} {n}", "needle.preset": n, key: v})
+            for v in per_needle.get(n, []):
+                cases.append({"label": f"{key}={v:g} {n}", "needle.preset": n, key: v})
+    if lip_depth:
+        for n in NEEDLES:
+            cases.append({"label": f"{key}={DEFAULT} {n}", "needle.preset": n})
     return {"model": "fast", "set": {"motion.travel_mm": travel_mm, "output.frames": 0}, "design": {"cases": cases}}
+
+
+def read_runs(folders):
+    """{needle: {value or DEFAULT: delta_mm}}, {needle: lip thickness (mm) of its unset run}, and the unfinished cases'
+    reasons, from the cases of one or more sweep folders (by label; a later folder's case of the same label wins)."""
+    deltas, lips, problems = {}, {}, []
+    for folder in folders:
+        for case_dir, r in case_records(os.path.join(folder, "cases")):
+            label = r.get("label", "")
+            value_text, needle = label.rsplit(" ", 1)
+            text = value_text.split("=", 1)[1]
+            value = DEFAULT if text == DEFAULT else float(text)
+            if r.get("status") == "finished" and r.get("deflection_mm") is not None:
+                deltas.setdefault(needle, {})[value] = r["deflection_mm"]
+                if value == DEFAULT:
+                    with open(os.path.join(case_dir, "run", "summary.json")) as f:
+                        lips[needle] = json.load(f).get("lip_release", {}).get("lip_thickness_mm", 0.0)
+            else:
+                problems.append(f"{label}: {r.get('status')} {r.get('reason', '')}")
+    return deltas, lips, problems
+
+
+def needle_curve(points, lip_mm=None, unset_mm=None):
+    """The needle's delta as a function of the value: linear between the values run; with a lip, its unset run stands
+    for every value from the lip's thickness on. None outside the values run."""
+    xs = sorted(points)
+    if lip_mm is not None and unset_mm is not None:
+        xs = [x for x in xs if x < lip_mm]
+        points = {**{x: points[x] for x in xs}, lip_mm: unset_mm}
+        xs.append(lip_mm)
+
+    def delta(v):
+        if lip_mm is not None and unset_mm is not None and v >= lip_mm:
+            return unset_mm
+        if not xs or v < xs[0] - 1e-12 or v > xs[-1] + 1e-12:
+            return None
+        for a, b in zip(xs, xs[1:]):
+            if v <= b:
+                t = (v - a) / (b - a)
+                return (1 - t) * points[a] + t * points[b]
+        return points[xs[-1]]
+    return delta, xs
+
+
+def ratios_from(deltas, lips, values=None, lip_depth=False):
+    """{value: {needle: ratio to SB, delta_SB_mm}} on the values where all four needles are known: every needle run at
+    every value; or, with lip_depth, each needle's curve (its values and its unset run) on the union of all values run and
+    the lips' thicknesses."""
+    ratios = {}
+    if not lip_depth:
+        for v in values:
+            d = {n: deltas.get(n, {}).get(float(v)) for n in NEEDLES}
+            if all(x is not None for x in d.values()):
+                ratios[float(v)] = {n: d[n] / d["SB"] for n in MULTI}
+                ratios[float(v)]["delta_SB_mm"] = d["SB"]
+        return ratios
+    curves, grid = {}, set()
+    for n in NEEDLES:
+        runs = {v: x for v, x in deltas.get(n, {}).items() if v != DEFAULT}
+        unset = deltas.get(n, {}).get(DEFAULT)
+        if unset is None:
+            raise StudyError(f"{n}: its run with the key unset did not finish; a lip-depth study needs it")
+        curves[n], xs = needle_curve(runs, lips.get(n, 0.0), unset)
+        grid.update(xs)
+    for v in sorted(grid):
+        d = {n: curves[n](v) for n in NEEDLES}
+        if all(x is not None for x in d.values()):
+            ratios[v] = {n: d[n] / d["SB"] for n in MULTI}
+            ratios[v]["delta_SB_mm"] = d["SB"]
+    return ratios
 
 
 def read_ratios(out, key, values):
     """{value: {needle: ratio to SB}} for the values whose four needles finished; and the missing ones' reasons."""
-    deltas, problems = {}, []
-    for _, r in case_records(os.path.join(out, "sweep", "cases")):
-        label = r.get("label", "")
-        value_text, needle = label.rsplit(" ", 1)
-        value = float(value_text.split("=", 1)[1])
-        if r.get("status") == "finished" and r.get("deflection_mm") is not None:
-            deltas.setdefault(value, {})[needle] = r["deflection_mm"]
-        else:
-            problems.append(f"{label}: {r.get('status')} {r.get('reason', '')}")
-    ratios = {}
-    for v in values:
-        d = deltas.get(float(v), {})
-        if all(n in d for n in NEEDLES):
-            ratios[float(v)] = {n: d[n] / d["SB"] for n in MULTI}
-            ratios[float(v)]["delta_SB_mm"] = d["SB"]
-    return ratios, problems
+    deltas, lips, problems = read_runs([os.path.join(out, "sweep")])
+    return ratios_from(deltas, lips, values), problems
 
 
 def interpolate(ratios, needle, value):
@@ -141,33 +218,91 @@ def main(argv):
     root = os.path.normpath(os.path.join(here, "..", ".."))
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--key", required=True, help="the scene key of the parameter, e.g. needle.groove_start_mm")
-    p.add_argument("--values", required=True, help="its values, comma-separated (at least 2)")
+    p.add_argument("--values", help="its values, comma-separated (at least 2), for every needle")
+    p.add_argument("--needle-values", nargs="+", metavar="NEEDLE=V,V", default=[],
+                   help="each needle's own values instead of --values (with --lip-depth), e.g. HMB=0.2,0.4 AMB=0.1,0.3")
+    p.add_argument("--lip-depth", action="store_true",
+                   help="the key is a depth into the lip below tip point A: each needle also runs with the key unset, "
+                        "which stands for it from its lip's thickness on (see above)")
     p.add_argument("--out", required=True, help="the study folder (created; reruns resume)")
+    p.add_argument("--runs", nargs="+", metavar="SWEEP_FOLDER",
+                   help="with --analyze-only: the sweep folders to read (default: OUT/sweep)")
     p.add_argument("--jobs", type=int, default=2, help="worker processes (default 2)")
     p.add_argument("--travel-mm", type=float, default=30.0, help="insertion travel (default 30, the paper's)")
     p.add_argument("--needle", default=os.path.join(root, "build", "apps", "needle"), help="the needle command")
     p.add_argument("--analyze-only", action="store_true", help="analyse the finished runs only")
+    p.add_argument("--record", metavar="FILE",
+                   help="also write the fit's record (what `needle paper --fitted` reads): the value fitted on --fit-on alone, "
+                        "rounded to --round, with the leave-one-needle-out table")
+    p.add_argument("--fit-on", choices=MULTI, help="with --record: the one needle the value is fitted on")
+    p.add_argument("--round", type=float, default=0.01, help="with --record: the shipped value's rounding (default 0.01)")
+    p.add_argument("--name", default="", help="with --record: the parameter's name in words, e.g. \"the crushed lip's depth\"")
+    p.add_argument("--unit", default="mm", help="with --record: the value's unit (default mm)")
     args = p.parse_args(argv)
     try:
-        try:
-            values = [float(v) for v in args.values.split(",") if v.strip()]
-        except ValueError:
-            raise StudyError(f"--values {args.values}: give numbers separated by commas")
-        if len(values) < 2 or len(set(values)) != len(values):
-            raise StudyError(f"--values {args.values}: give at least two different values")
-        values.sort()
+        def numbers(text, what):
+            try:
+                vs = [float(v) for v in text.split(",") if v.strip()]
+            except ValueError:
+                raise StudyError(f"{what} {text}: give numbers separated by commas")
+            if len(set(vs)) != len(vs):
+                raise StudyError(f"{what} {text}: a value is given twice")
+            return sorted(vs)
+        values, needle_values = [], None
+        if args.needle_values:
+            if args.values or not args.lip_depth:
+                raise StudyError("--needle-values goes with --lip-depth and instead of --values")
+            needle_values = {}
+            for item in args.needle_values:
+                name, _, text = item.partition("=")
+                if name not in MULTI:
+                    raise StudyError(f"--needle-values {item}: the needle must be one of {', '.join(MULTI)}")
+                needle_values[name] = numbers(text, f"--needle-values {name}=")
+            values = sorted({v for vs in needle_values.values() for v in vs})
+            if len(values) < 2 and not args.analyze_only:
+                raise StudyError("--needle-values: give at least two different values in all")
+        elif not (args.analyze_only and args.lip_depth):  # a lip-depth study reads its values from its runs
+            if not args.values:
+                raise StudyError("give --values (or --needle-values with --lip-depth)")
+            values = numbers(args.values, "--values")
+            if len(values) < 2:
+                raise StudyError(f"--values {args.values}: give at least two different values")
+        if bool(args.record) != bool(args.fit_on):
+            raise StudyError("--record and --fit-on go together")
+        if args.round <= 0:
+            raise StudyError(f"--round {args.round}: give a positive step")
+        if args.runs and not args.analyze_only:
+            raise StudyError("--runs reads finished sweeps: give it with --analyze-only")
         if not args.analyze_only:
             os.makedirs(args.out, exist_ok=True)
-            path = write_sweep_file(os.path.join(args.out, "sweep.json"), sweep_file(args.key, values, args.travel_mm))
+            path = write_sweep_file(os.path.join(args.out, "sweep.json"),
+                                    sweep_file(args.key, values, args.travel_mm, needle_values, args.lip_depth))
             status = subprocess.call([args.needle, "sweep", path, "--out", os.path.join(args.out, "sweep"), "--jobs", str(args.jobs)])
             if status not in (0, 3):  # 3: some cases did not finish; the values whose four needles did are analysed
                 raise StudyError(f"needle sweep exited {status}")
-        ratios, problems = read_ratios(args.out, args.key, values)
+        os.makedirs(args.out, exist_ok=True)
+        deltas, lips, problems = read_runs(args.runs or [os.path.join(args.out, "sweep")])
+        ratios = ratios_from(deltas, lips, values, args.lip_depth)
         for line in problems:
             print("second_parameter: not finished:", line)
         result = analyse(args.key, ratios)
         with open(os.path.join(args.out, "second_parameter.json"), "w") as f:
             json.dump(result, f, indent=1)
+        if args.record:
+            chosen = next(s_ for s_ in result["fitted_on_one"] if s_["fitted_on"] == args.fit_on)
+            record = {"description": "A parameter besides E fitted to one paper needle, and the leave-one-needle-out errors "
+                                     "that say how well it predicts the needles it was not fitted on "
+                                     "(studies/sensitivity/second_parameter.py --record).",
+                      "key": args.key, "name": args.name or args.key, "unit": args.unit, "fitted_on": args.fit_on,
+                      "value_fitted": chosen["value"], "at_range_end": chosen["at_range_end"],
+                      "value": round(round(chosen["value"] / args.round) * args.round, 10),
+                      "study": os.path.relpath(os.path.abspath(args.out), root),
+                      "predictions_mm": chosen["predictions_mm"], "errors_mm": chosen["errors_mm"],
+                      "leave_one_out": result["leave_one_out"], "fitted_on_one": result["fitted_on_one"],
+                      "measured_mm": MEASURED_MM, "two_sd_mm": result["two_sd_mm"]}
+            with open(args.record, "w") as f:
+                json.dump(record, f, indent=1)
+                f.write("\n")
         text = markdown(result)
         with open(os.path.join(args.out, "second_parameter.md"), "w") as f:
             f.write(text)

@@ -383,7 +383,7 @@ TEST_CASE("needle run --tissue-entry-x-mm: the block starts there, the rod meets
   }
 }
 
-TEST_CASE("tissue.contact.lip_release_mode: crushed by default, free or off on request, SB has no lip, bad input is refused",
+TEST_CASE("tissue.contact.lip_release_mode: crushed 0.45 mm deep by default, the whole lip, free or off on request, SB has no lip, bad input is refused",
           "[apps][lspg][gmsh][lip][slow]") {
   // HMB's tip point sits 0.80 mm above the rod's bottom: pushed 0.8 mm into the small block (0.4 mm particles), the particles
   // the tip passes below A inside the rod's outline are crushed by default (bonds kept), cut loose when free (every bond
@@ -391,14 +391,16 @@ TEST_CASE("tissue.contact.lip_release_mode: crushed by default, free or off on r
   const std::string hmb = R"("preset": "HMB")";
   const RunFiles off = run_sb_into_small_block("lip_off", "--set tissue.contact.lip_release_mode=off", hmb);
   const RunFiles crushed = run_sb_into_small_block("lip_crushed", "", hmb);
+  const RunFiles whole = run_sb_into_small_block("lip_whole", "--set \"tissue.contact.lip_release_depth_mm=whole lip\"", hmb);
   const RunFiles free_band = run_sb_into_small_block("lip_free", "--set tissue.contact.lip_release_mode=free --set tissue.contact.lip_release_depth_mm=0.8", hmb);
   CHECK(off.scene["tissue"]["contact"]["lip_release_mode"] == "off");
   CHECK(crushed.scene["tissue"]["contact"]["lip_release_mode"] == "crushed");
-  CHECK_FALSE(crushed.scene["tissue"]["contact"].contains("lip_release_depth_mm"));  // the whole lip
+  CHECK(crushed.scene["tissue"]["contact"]["lip_release_depth_mm"].get<double>() == needle::kSceneCrushedLipDepthMm);
+  CHECK(whole.scene["tissue"]["contact"]["lip_release_depth_mm"] == "whole lip");
   CHECK(free_band.scene["tissue"]["contact"]["lip_release_depth_mm"].get<double>() == 0.8);
   CHECK_FALSE(off.summary.contains("lip_release"));
   INFO("crushed " << crushed.summary["lip_release"].dump() << "; free " << free_band.summary["lip_release"].dump());
-  for (const RunFiles* r : {&crushed, &free_band}) {
+  for (const RunFiles* r : {&crushed, &whole, &free_band}) {
     const nlohmann::json& lip = r->summary["lip_release"];
     CHECK(lip["lip_thickness_mm"].get<double>() == Approx(0.80).margin(0.02));
     CHECK(lip["particles_released"].get<long>() > 0);
@@ -407,7 +409,10 @@ TEST_CASE("tissue.contact.lip_release_mode: crushed by default, free or off on r
     CHECK(r->summary["energy_balance_error"].get<double>() < 0.02);
   }
   CHECK(crushed.summary["lip_release"]["bonds_cut"].get<long>() == 0);
-  CHECK(crushed.summary["lip_release"]["depth_mm"] == "whole lip");
+  CHECK(crushed.summary["lip_release"]["depth_mm"].get<double>() == needle::kSceneCrushedLipDepthMm);
+  CHECK(whole.summary["lip_release"]["depth_mm"] == "whole lip");
+  // HMB's lip is 0.80 mm: the whole lip holds more particles than its top 0.45 mm.
+  CHECK(whole.summary["lip_release"]["particles_released"].get<long>() > crushed.summary["lip_release"]["particles_released"].get<long>());
   CHECK(free_band.summary["lip_release"]["bonds_cut"].get<long>() > 0);
   CHECK(free_band.summary["bonds_broken"].get<long>() >=
         free_band.summary["lip_release"]["bonds_cut"].get<long>() + free_band.summary["bonds_cut_by_needle"].get<long>());
@@ -423,6 +428,7 @@ TEST_CASE("tissue.contact.lip_release_mode: crushed by default, free or off on r
   for (const auto& [flags, message] :
        {std::pair<std::string, std::string>{"--set tissue.contact.lip_release_depth_mm=0", "lip_release_depth_mm"},
         {"--set tissue.contact.lip_release_below_mm=-0.1", "lip_release_below_mm"},
+        {"--set tissue.contact.lip_release_depth_mm=all", "give a depth in mm or \"whole lip\" (got \"all\")"},
         {"--set tissue.contact.lip_release_mode=dissolved", "must be crushed, free or off (got 'dissolved')"}}) {
     refused_in_one_line("lip_bad", flags, message);
   }

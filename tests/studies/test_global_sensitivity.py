@@ -160,6 +160,36 @@ with tempfile.TemporaryDirectory() as tmp:
     count = subprocess.run([needle, "sweep", path, "--count"], capture_output=True, text=True)
     check(count.returncode == 0 and count.stdout.strip() == "8", f"second parameter: its sweep file passes needle sweep --count ({count.stdout.strip()})")
 
+# A depth into the lip (--lip-depth): each needle's own values, its run with the key unset standing for it from its lip on.
+D = sp.DEFAULT
+lip_deltas = {"SB": {D: -1.14},
+              "LMB": {0.1: 0.40, D: 0.10},                      # lip 0.21: 0.10 from 0.21 on
+              "AMB": {0.1: 1.00, 0.3: 0.50, D: 0.20},           # lip 0.43
+              "HMB": {0.2: 1.71 + 3 * 0.25, 0.4: 1.71 + 3 * 0.05, 0.6: 1.71 - 3 * 0.15, D: 1.71 - 3 * 0.35}}  # lip 0.8
+lips = {"SB": 0.0, "LMB": 0.21, "AMB": 0.43, "HMB": 0.8}
+lr = sp.ratios_from(lip_deltas, lips, lip_depth=True)
+check(min(lr) == 0.2 and max(lr) == 0.8, f"lip depth: the values analysed are where every needle is known, 0.2 to HMB's lip ({min(lr)}, {max(lr)})")
+check(abs(lr[0.6]["AMB"] * -1.14 - 0.20) < 1e-12 and abs(lr[0.43]["AMB"] * -1.14 - 0.20) < 1e-12,
+      "lip depth: from its lip's thickness on, a needle is its run with the key unset")
+check(abs(lr[0.2]["LMB"] * -1.14 - (0.40 + (0.10 - 0.40) * 0.1 / 0.11)) < 1e-12,
+      "lip depth: between its last value and its lip, a needle is interpolated towards its unset run")
+lip_fit = sp.analyse("tissue.contact.lip_release_depth_mm", lr)
+hmb_only = next(s_ for s_ in lip_fit["fitted_on_one"] if s_["fitted_on"] == "HMB")
+check(abs(hmb_only["value"] - 0.45) < 0.002 and abs(hmb_only["errors_mm"]["AMB"] - (0.20 - 0.24)) < 1e-9,
+      f"lip depth: fitted on HMB alone the depth solves HMB's line ({hmb_only['value']:.4f} against 0.45), AMB is its unset run")
+with tempfile.TemporaryDirectory() as tmp:
+    path = os.path.join(tmp, "sweep.json")
+    with open(path, "w") as f:
+        json.dump(sp.sweep_file("tissue.contact.lip_release_depth_mm", [], 30.0, {"HMB": [0.2, 0.4], "AMB": [0.1]}, True), f)
+    count = subprocess.run([needle, "sweep", path, "--count"], capture_output=True, text=True)
+    check(count.returncode == 0 and count.stdout.strip() == "7",
+          f"lip depth: each needle's own values and the four unset runs pass needle sweep --count ({count.stdout.strip()})")
+    script = os.path.join(source, "studies", "sensitivity", "second_parameter.py")
+    r = subprocess.run([sys.executable, script, "--key", "tissue.contact.lip_release_depth_mm", "--needle-values", "HMB=0.2,0.4",
+                        "--out", os.path.join(tmp, "o")], capture_output=True, text=True)
+    check(r.returncode == 2 and "--lip-depth" in r.stderr and not os.path.exists(os.path.join(tmp, "o")),
+          f"per-needle values without --lip-depth are refused, nothing written ({r.stderr.strip()})")
+
 # Bad study files.
 with tempfile.TemporaryDirectory() as tmp:
     bad = os.path.join(tmp, "bad.json")

@@ -9,6 +9,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
+#include "solver/separation/separation_models.h"
 #include "studies/paper_results.h"
 #include "tests/apps/cli_run.h"
 
@@ -33,7 +34,8 @@ void write_run(const fs::path& dir, const std::string& name, const FakeRun& r) {
                         {"groove", {{"groove_fill", r.groove_fill}, {"floor_contact_fraction", r.groove_fill / 2}, {"mean_gap_mm", 0.1}}}};
   std::ofstream(folder / "summary.json") << summary.dump(2);
   const json scene = {{"tissue", {{"spacing_mm", 0.4}, {"path_refinement", 2}, {"path_half_width_mm", 1.2},
-                                  {"contact", {{"cuts_bonds", true}, {"lip_release_mode", "crushed"}}}}}};
+                                  {"contact", {{"cuts_bonds", true}, {"lip_release_mode", "crushed"},
+                                               {"lip_release_depth_mm", needle::kSceneCrushedLipDepthMm}}}}}};
   std::ofstream(folder / "scene.json") << scene.dump(2);
   std::ofstream history(folder / "history.csv");
   history << "time_ms,insertion_mm,deflection_mm\n";
@@ -470,6 +472,40 @@ TEST_CASE("needle paper --report-only says when its runs kept the lip below the 
   REQUIRE(result.exit_code == 0);
   CHECK(read_text(dir / "report.md").find("the needle cuts the bonds its body passes through; the lip below the tip point stays as the tissue "
                                           "is (no lip release)") != std::string::npos);
+}
+
+TEST_CASE("needle paper names a parameter fitted on HMB, with its leave-one-out errors, only where the runs use its value",
+          "[apps][paper][slow]") {
+  // The record as studies/sensitivity/second_parameter.py --record writes it: the crushed lip's depth fitted on HMB.
+  const fs::path dir = fresh("fitted");
+  for (const char* name : {"SB", "LMB", "AMB", "HMB"}) write_run(dir, name, {-1.1, 0.9});
+  const json record = {{"key", "tissue.contact.lip_release_depth_mm"}, {"name", "the crushed lip's depth"}, {"unit", "mm"},
+                       {"fitted_on", "HMB"}, {"value", needle::kSceneCrushedLipDepthMm}, {"value_fitted", 0.4521}, {"study", "docs/study"},
+                       {"leave_one_out", {{{"held_out", "AMB"}, {"fitted_on", {"LMB", "HMB"}}, {"value", 0.455}, {"at_range_end", false},
+                                           {"prediction_mm", -0.011}, {"error_mm", -0.251}}}}};
+  const fs::path record_path = dir / "fit.json";
+  std::ofstream(record_path) << record.dump(2);
+  const std::string command = "paper --report-only --no-tips --quiet --fitted " + record_path.string() + " --out " + dir.string();
+  auto result = run(command, true);
+  INFO(result.out);
+  REQUIRE(result.exit_code == 0);
+  std::string md = read_text(dir / "report.md");
+  CHECK(md.find("## One more parameter fitted to a needle: the crushed lip's depth, on HMB alone") != std::string::npos);
+  CHECK(md.find("`tissue.contact.lip_release_depth_mm` = 0.45 mm in these runs is fitted on HMB (0.4521 fitted, rounded") != std::string::npos);
+  // The measured value is the prediction less its error: -0.011 + 0.251.
+  CHECK(md.find("| AMB | LMB, HMB | 0.455 | -0.011 | +0.24 | -0.251 |") != std::string::npos);
+  CHECK(md.find("the whole lip") == std::string::npos);  // the default lip goes unnamed in the model's description
+  CHECK(md.find("--fitted " + record_path.string()) != std::string::npos);  // the command that regenerates it
+
+  // Runs with the whole lip crushed (the default of 2026-11-27): nothing here is fitted but E, and the lip is said.
+  const json whole = {{"tissue", {{"spacing_mm", 0.4}, {"path_refinement", 2}, {"path_half_width_mm", 1.2},
+                                  {"contact", {{"cuts_bonds", true}, {"lip_release_mode", "crushed"}, {"lip_release_depth_mm", "whole lip"}}}}}};
+  for (const char* name : {"SB", "LMB", "AMB", "HMB"}) std::ofstream(dir / "runs" / name / "scene.json") << whole.dump(2);
+  result = run(command, true);
+  REQUIRE(result.exit_code == 0);
+  md = read_text(dir / "report.md");
+  CHECK(md.find("One more parameter fitted") == std::string::npos);
+  CHECK(md.find("the whole lip below the tip point is crushed (lip release)") != std::string::npos);
 }
 
 TEST_CASE("needle paper without --calibration takes the shipped SB calibration, as needle run does", "[apps][paper][slow]") {
