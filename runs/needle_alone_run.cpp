@@ -7,7 +7,9 @@
 
 #include "runs/scene_needle.h"
 #include "core/parallel.h"
+#include "core/input_error.h"
 #include "solver/needle/needle_dynamics.h"
+#include "solver/needle/needle_models.h"
 
 namespace needle {
 namespace {
@@ -17,6 +19,11 @@ using Clock = std::chrono::steady_clock;
 class NeedleAloneModel : public RunModel {
  public:
   explicit NeedleAloneModel(const Scene& scene) : scene_(scene) {
+    // It drives the explicit FE needle itself: another model asked for is refused, not replaced (issue 49).
+    NEEDLE_REQUIRE(needle_model(scene.needle.model).runs_alone,
+                   fmt::format("needle.model {}: a needle-alone run (tissue.enabled false) runs the explicit FE needle only; give "
+                               "needle.model fe, or a tissue to insert into",
+                               scene.needle.model));
     built_ = build_scene_needle(scene.needle);
     needle_ = std::make_unique<FeNeedle>(built_.mesh, scene.needle.material, scene.solver.mass_scaling_dt_ms);
     run_ = std::make_unique<NeedleDynamics>(*needle_, driven_base_supports(needle_->mesh(), scene.motion, scene.direction),

@@ -34,13 +34,18 @@ namespace {
 
 // The parameter besides E fitted to a needle, named as fitted, with its leave-one-needle-out errors: when the fitted
 // needle's run here uses the record's value (the record: studies/sensitivity/second_parameter.py --record).
-std::string fitted_parameter_section(const PaperReportInput& in, const fs::path& dir) {
-  if (in.fitted_path.empty() || !fs::is_regular_file(in.fitted_path)) return "";
+struct FittedParameter {
+  std::string needle, name;  // empty: nothing but E is fitted in these runs
+  std::string section;       // the report's section
+};
+
+FittedParameter fitted_parameter(const PaperReportInput& in, const fs::path& dir) {
+  if (in.fitted_path.empty() || !fs::is_regular_file(in.fitted_path)) return {};
   const json record = read_json_file(in.fitted_path, "fitted parameter record");
   const std::string key = record.value("key", std::string()), needle = record.value("fitted_on", std::string());
   const double value = record.value("value", kNaN);
   const fs::path scene_path = dir / "runs" / needle / "scene.json";
-  if (key.empty() || needle.empty() || !std::isfinite(value) || !fs::is_regular_file(scene_path)) return "";
+  if (key.empty() || needle.empty() || !std::isfinite(value) || !fs::is_regular_file(scene_path)) return {};
   std::string pointer;
   for (size_t start = 0; start <= key.size();) {
     const size_t end = std::min(key.find('.', start), key.size());
@@ -49,7 +54,7 @@ std::string fitted_parameter_section(const PaperReportInput& in, const fs::path&
   }
   const json scene = read_json_file(scene_path.string(), "run scene");
   const json::json_pointer at(pointer);
-  if (!scene.contains(at) || !scene.at(at).is_number() || scene.at(at).get<double>() != value) return "";
+  if (!scene.contains(at) || !scene.at(at).is_number() || scene.at(at).get<double>() != value) return {};
   std::string md = fmt::format("## One more parameter fitted to a needle: {}, on {} alone\n\n", record.value("name", key), needle);
   md += fmt::format("`{}` = {:g} {} in these runs is fitted on {} ({:.4g} fitted, rounded; the study: `{}`). {}'s deflection "
                     "here is therefore a fit, not a prediction, as SB's is through E. Leave one needle out: the value fitted to "
@@ -63,7 +68,7 @@ std::string fitted_parameter_section(const PaperReportInput& in, const fs::path&
                       h.value("at_range_end", false) ? " (range end)" : "", h.value("prediction_mm", kNaN),
                       h.value("prediction_mm", kNaN) - h.value("error_mm", kNaN), h.value("error_mm", kNaN));
   md += "\n";
-  return md;
+  return {needle, record.value("name", key), md};
 }
 
 // What one needle's run folder says.
@@ -403,7 +408,8 @@ void write_paper_report(const PaperReportInput& in) {
                           "with the same flags before reading the others as predictions.\n\n",
                           r.name, r.deflection_mm, cal_deflection);
   }
-  md += fitted_parameter_section(in, dir);
+  const FittedParameter fitted = fitted_parameter(in, dir);
+  md += fitted.section;
   md += "## Deflection at the end of insertion (mm, +y up: the groove side)\n\n";
   md += "| needle | d_a (mm) | this toolkit | experiment | LS-DYNA (paper) | ours - experiment | status | run time |\n";
   md += "|---|---|---|---|---|---|---|---|\n";
@@ -425,6 +431,9 @@ void write_paper_report(const PaperReportInput& in) {
     if (t.met && !replicas.empty() && scatter.targets[i].met < scatter.targets[i].checked)
       verdict = fmt::format("met here, **not in {} of {} replicas** (run-to-run scatter below)",
                             scatter.targets[i].checked - scatter.targets[i].met, scatter.targets[i].checked);
+    // A target on the needle a parameter was fitted to is met by the fit, not predicted.
+    if (t.checked && !fitted.needle.empty() && t.needle == fitted.needle)
+      verdict += fmt::format(" (by a fit: {} is fitted on {})", fitted.name, fitted.needle);
     md += fmt::format("| {} | {} | {} |\n", t.what, t.numbers, verdict);
   }
   {

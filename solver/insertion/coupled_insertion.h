@@ -1,7 +1,8 @@
 #pragma once
-// The L-SPG insertion: a needle model (needle/needle_model.h: the FE needle, or the rigid one) driven into
-// the SPG tissue (tissue/spg_tissue.h, tissue/tissue_dynamics.h) through the frictional penalty contact
-// (contact/needle_tissue_contact.h), the tissue separated after each step by the scene's separation models
+// The L-SPG insertion: a needle model (needle/needle_model.h: the explicit FE needle, the implicit linear one
+// or the rigid one) driven into the SPG tissue (tissue/spg_tissue.h, tissue/tissue_dynamics.h) through a
+// contact law (contact/needle_tissue_contact.h: the frictional penalty, or the kinematic projection of the
+// default model level), the tissue separated after each step by the scene's separation models
 // (separation/separation_models.h), in one explicit run with two clocks. The coupled step, as step() reads:
 //   1. plan dt: the tissue's stable step, capped by the contact law's limit (the penalty's: contact_courant of
 //      its own; a kinematic law has none) and the end time, cut to a whole number of the needle's step grid;
@@ -12,7 +13,7 @@
 //      particles away from the needle update their stresses (step 6's first stage, which the contact cannot change);
 //   5. the contact ends the step: its force at t + dt on the particles (penalty) or its impulses (projection);
 //   6. the tissue's second half: its forces at t + dt with the contact's, the half kick;
-//   7. each separation model separates the tissue (the needle's cut, the slit, the crack);
+//   7. each separation model separates the tissue (the needle's cut, the slit, the crack, the lip's release);
 //   8. the energy account, penetration and drift checks (each body checks its own NaN and blow-up).
 // Each step, the needle receives -C(t) over its substeps and the tissue (C(t) + C(t + dt)) dt / 2: momentum
 // is exchanged exactly up to a half-step lag that never accumulates (it telescopes to dt/2 |C(end) - C(0)|).

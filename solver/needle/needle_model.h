@@ -2,9 +2,10 @@
 // What the coupled insertion needs of a needle, whichever model moves it: its nodes (positions,
 // velocities, masses) on the FE mesh's surface, its own stable step, `advance_to(t, loads)` under loads
 // that depend on its state (the tissue's contact, re-evaluated at each of its own steps), its energy
-// account and the drive's reaction. The explicit FE needle (needle_dynamics.h) and the rigid needle
-// (rigid_needle.h) implement it; needle_models.h builds one by name. A new model is one file that
-// implements this and one line in needle_models.cpp.
+// account and the drive's reaction. The explicit FE needle (needle_dynamics.h), the implicit linear needle
+// (implicit_needle.h, the default model level's) and the rigid needle (rigid_needle.h) implement it;
+// needle_models.h builds one by name. A new model is one file that implements this and one line in
+// needle_models.cpp.
 #include <Eigen/Dense>
 #include <nlohmann/json_fwd.hpp>
 #include <string>

@@ -22,6 +22,7 @@ struct NeedleModelInputs {
 struct NeedleModelEntry {
   std::string name, description;
   bool mass_scaled;  // it takes explicit steps, which selective mass scaling lengthens (a rigid needle takes any step)
+  bool runs_alone;   // a needle-alone run (no tissue) can drive it: the explicit FE needle with its cannula
   std::unique_ptr<NeedleModel> (*make)(const NeedleModelInputs& inputs);
 };
 

@@ -478,7 +478,8 @@ TEST_CASE("needle paper names a parameter fitted on HMB, with its leave-one-out 
           "[apps][paper][slow]") {
   // The record as studies/sensitivity/second_parameter.py --record writes it: the crushed lip's depth fitted on HMB.
   const fs::path dir = fresh("fitted");
-  for (const char* name : {"SB", "LMB", "AMB", "HMB"}) write_run(dir, name, {-1.1, 0.9});
+  for (const auto& [name, delta_mm] : std::map<std::string, double>{{"SB", -1.14}, {"LMB", 0.15}, {"AMB", 0.24}, {"HMB", 1.71}})
+    write_run(dir, name, {delta_mm, 0.9});
   const json record = {{"key", "tissue.contact.lip_release_depth_mm"}, {"name", "the crushed lip's depth"}, {"unit", "mm"},
                        {"fitted_on", "HMB"}, {"value", needle::kSceneCrushedLipDepthMm}, {"value_fitted", 0.4521}, {"study", "docs/study"},
                        {"leave_one_out", {{{"held_out", "AMB"}, {"fitted_on", {"LMB", "HMB"}}, {"value", 0.455}, {"at_range_end", false},
@@ -495,6 +496,9 @@ TEST_CASE("needle paper names a parameter fitted on HMB, with its leave-one-out 
   // The measured value is the prediction less its error: -0.011 + 0.251.
   CHECK(md.find("| AMB | LMB, HMB | 0.455 | -0.011 | +0.24 | -0.251 |") != std::string::npos);
   CHECK(md.find("the whole lip") == std::string::npos);  // the default lip goes unnamed in the model's description
+  // HMB's target is met by the fit, and the verdict says so; no other target's is.
+  CHECK(md.find("| met (by a fit: the crushed lip's depth is fitted on HMB) |") != std::string::npos);
+  CHECK(md.find("by a fit") == md.rfind("by a fit"));
   CHECK(md.find("--fitted " + record_path.string()) != std::string::npos);  // the command that regenerates it
 
   // Runs with the whole lip crushed (the default of 2026-11-27): nothing here is fitted but E, and the lip is said.
