@@ -210,8 +210,9 @@ class InsertionOutput {
 }  // namespace
 
 std::string default_calibration_file(const std::string& model_level) {
-  const bool full_model = model_level == "full" || model_level == "projection";
-  return std::string(NEEDLE_DATA_DIR) + (full_model ? "/paper/calibration_sb_full.json" : "/paper/calibration_sb.json");
+  // A level's own calibration; a custom combination takes the default (fast) level's.
+  const ModelLevel* level = find_model_level(model_level);
+  return std::string(NEEDLE_DATA_DIR) + "/paper/" + (level ? level->calibration_file : find_model_level(kDefaultModelLevel)->calibration_file);
 }
 
 double calibrated_E(const std::string& path) {
@@ -279,7 +280,8 @@ class InsertionRunModel : public RunModel {
     CouplingOptions coupling = scene.solver.coupling;
     if (scene.solver.tissue_mass_scaling || scene.solver.tissue_mass_scaling_dt_ms > 0)
       coupling.tissue_mass_scaling_dt_ms = scene.solver.tissue_mass_scaling_dt_ms > 0 ? scene.solver.tissue_mass_scaling_dt_ms
-                                           : scene.needle.model == "implicit" ? kMassScalingTargetPerNeedleStep * dynamics.implicit_step_ms
+                                           : needle_model(scene.needle.model).takes_coupling_step
+                                               ? kMassScalingTargetPerNeedleStep * dynamics.implicit_step_ms
                                                                               : 0.5 * tissue_->stable_time_step_ms();
     run_ = std::make_unique<CoupledInsertion>(*needle_model_, *tissue_, *surface_, scene.tissue.contact, std::move(separations), coupling,
                                               cutting);
@@ -290,9 +292,8 @@ class InsertionRunModel : public RunModel {
   std::vector<std::string> setup_log() const override {
     const FeNeedle& n = *needle_;
     const ContactSurface& surface = *surface_;
-    return {fmt::format("needle {}: {} T{} elements, {} nodes, meshed in {:.2f} s{}", built_.name, built_.mesh.num_tets(),
-                        built_.mesh.order == 2 ? 10 : 4, built_.mesh.num_nodes(), built_.mesh_seconds,
-                        scene_.needle.model == "fe" ? "" : " (" + scene_.needle.model + ")"),
+    return {fmt::format("needle {}: {} T{} elements, {} nodes, meshed in {:.2f} s", built_.name, built_.mesh.num_tets(),
+                        built_.mesh.order == 2 ? 10 : 4, built_.mesh.num_nodes(), built_.mesh_seconds),
             fmt::format("model {}: {} needle, {} contact, {} kernel supports", model_level_of(scene_), needle_model_->name(),
                         run_->contact_model().law(), support_shape_name(scene_.tissue.spg.support)),
             fmt::format("needle stable step {:.4g} ms (unscaled {:.4g} ms); added mass {:.3g} % in {} elements", n.stable_time_step_ms(),

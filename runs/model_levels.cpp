@@ -3,17 +3,21 @@
 #include <fmt/format.h>
 
 #include "core/input_error.h"
+#include "solver/contact/contact_laws.h"
+#include "solver/needle/needle_models.h"
 
 namespace needle {
 
 const std::vector<ModelLevel>& model_levels() {
   static const std::vector<ModelLevel> levels = {
       {"full", "fe", "penalty", false, SupportShape::sphere, 0,
-       "explicit FE needle subcycled in the tissue's step, frictional penalty contact (the reference)"},
-      {"projection", "fe", "projection", false, SupportShape::sphere, 0, "explicit FE needle, kinematic contact: the tissue's own step"},
+       "explicit FE needle subcycled in the tissue's step, frictional penalty contact (the reference)", "calibration_sb_full.json"},
+      {"projection", "fe", "projection", false, SupportShape::sphere, 0, "explicit FE needle, kinematic contact: the tissue's own step",
+       "calibration_sb_full.json"},
       {"fast", "implicit", "projection", true, SupportShape::ellipsoid, 3,
        "implicit linear needle at the coupling step, kinematic contact, tissue mass-scaled where its step is short (to a quarter of the needle's step): no subcycling; "
-       "ellipsoidal kernel supports on the graded lattice; the tissue away from the needle at up to 8 coupling steps (multi-rate)"},
+       "ellipsoidal kernel supports on the graded lattice; the tissue away from the needle at up to 8 coupling steps (multi-rate)",
+       "calibration_sb.json"},
   };
   return levels;
 }
@@ -35,6 +39,12 @@ void apply_model_level(Scene& scene, const std::string& name, const std::string&
   throw InputError(fmt::format("{}: unknown model level '{}' (known: {})", where, name, known));
 }
 
+const ModelLevel* find_model_level(const std::string& name) {
+  for (const ModelLevel& level : model_levels())
+    if (level.name == name) return &level;
+  return nullptr;
+}
+
 std::string model_level_of(const Scene& scene) {
   for (const ModelLevel& level : model_levels())
     if (scene.needle.model == level.needle_model && scene.tissue.contact.law == level.contact_law &&
@@ -45,9 +55,14 @@ std::string model_level_of(const Scene& scene) {
 }
 
 void check_model_combination(const Scene& scene) {
-  NEEDLE_REQUIRE(!(scene.needle.model == "implicit" && scene.tissue.contact.law == "penalty"),
-                 "needle.model implicit needs tissue.contact.law projection: the implicit needle holds its loads over its step, "
-                 "which a penalty's force does not allow (--model fast sets both)");
+  const NeedleModelEntry& model = needle_model(scene.needle.model);
+  if (!model.takes_coupling_step || contact_law(scene.tissue.contact.law).constant_over_needle_step) return;
+  std::string laws;
+  for (const ContactLawEntry& law : contact_laws())
+    if (law.constant_over_needle_step) laws += (laws.empty() ? "" : " or ") + law.name;
+  throw InputError(fmt::format("needle.model {} needs tissue.contact.law {}: the {} needle holds its loads over its step, which a "
+                               "{}'s force does not allow (--model fast sets both)",
+                               model.name, laws, model.name, scene.tissue.contact.law));
 }
 
 }  // namespace needle

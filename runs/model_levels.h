@@ -23,13 +23,19 @@ struct ModelLevel {
   SupportShape support = SupportShape::sphere;
   int tissue_rate_levels = 0;  // multi-rate stepping of the tissue (solver.tissue_rate_levels; 0: one rate)
   std::string description;
+  std::string calibration_file;  // its shipped SB calibration, in data/paper/ (`needle calibrate` with that level)
 };
+
+// The reference level, against which the others' error is measured (`needle bench insertion`).
+inline constexpr const char* kReferenceModelLevel = "full";
 
 const std::vector<ModelLevel>& model_levels();
 // Sets the level's keys; InputError naming where and the known levels for an unknown name.
 void apply_model_level(Scene& scene, const std::string& name, const std::string& where = "--model");
 // The level a scene's keys make, or "custom" (e.g. a rigid needle).
 std::string model_level_of(const Scene& scene);
+// The level named so; nullptr for another name ("custom").
+const ModelLevel* find_model_level(const std::string& name);
 // InputError for a combination no level allows: the implicit needle with the penalty contact.
 void check_model_combination(const Scene& scene);
 

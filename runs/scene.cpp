@@ -11,6 +11,7 @@
 #include "runs/scene_object.h"
 #include "core/input_error.h"
 #include "core/units.h"
+#include "solver/contact/contact_laws.h"
 #include "solver/needle/needle_models.h"
 
 namespace needle {
@@ -173,8 +174,7 @@ void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc) {
   if (o.has("contact")) {
     SceneObject c = o.child("contact");
     t.contact.law = c.text("law", t.contact.law);
-    NEEDLE_REQUIRE(t.contact.law == "penalty" || t.contact.law == "projection",
-                   c.where("law") + ": must be penalty or projection (got '" + t.contact.law + "')");
+    contact_law(t.contact.law, c.where("law"));  // InputError for an unknown law
     t.contact.stiffness_factor = c.number("stiffness_factor", t.contact.stiffness_factor, within(1e-3, 1e4));
     t.contact.skin_mm = c.quantity("skin", Dimension::length, t.contact.skin_mm, non_negative());
     t.contact.voxel_mm = c.quantity("voxel", Dimension::length, t.contact.voxel_mm, within(1e-3, 0.2));
@@ -313,7 +313,7 @@ json scene_to_json(const Scene& s) {
   }
   if (t.cutting.pressure_MPa > 0) tissue["contact"]["cutting_pressure_MPa"] = t.cutting.pressure_MPa;
   if (t.offset_y_mm != 0) tissue["offset_y_mm"] = t.offset_y_mm;
-  if (t.contact.law != "penalty") tissue["contact"]["law"] = t.contact.law;
+  if (t.contact.law != ContactOptions{}.law) tissue["contact"]["law"] = t.contact.law;
   if (t.separation.crack.enabled()) {
     tissue["contact"]["crack_reach_mm"] = t.separation.crack.reach_mm;
     tissue["contact"]["crack_angles_deg"] = t.separation.crack.angles_deg;
@@ -338,7 +338,7 @@ json scene_to_json(const Scene& s) {
                  {"threads", s.solver.threads}, {"subcycling", s.solver.coupling.subcycling},
                  {"max_coupling_step_ms", s.solver.coupling.max_step_ms}, {"contact_courant", s.solver.coupling.contact_courant},
                  {"max_contact_depth_mm", s.solver.coupling.max_depth_mm}};
-  if (s.needle.model == "implicit") solver["implicit_needle_step_ms"] = s.solver.implicit_needle_step_ms;
+  if (needle_model(s.needle.model).takes_coupling_step) solver["implicit_needle_step_ms"] = s.solver.implicit_needle_step_ms;
   if (s.solver.tissue_mass_scaling) solver["tissue_mass_scaling"] = true;
   if (s.solver.tissue_mass_scaling_dt_ms > 0) solver["tissue_mass_scaling_dt_ms"] = s.solver.tissue_mass_scaling_dt_ms;
   // Written only when not the default (the same results either way: a matter of speed).

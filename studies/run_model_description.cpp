@@ -8,7 +8,10 @@
 #include "runs/scene.h"
 #include "geometry/grinding_recipe.h"
 #include "solver/needle/insertion_profile.h"
+#include "runs/model_levels.h"
+#include "solver/contact/contact_laws.h"
 #include "solver/contact/needle_tissue_contact.h"
+#include "solver/needle/needle_models.h"
 #include "solver/tissue/tissue_material.h"
 
 namespace needle {
@@ -85,10 +88,16 @@ std::string describe_run_model(const json& scene, long particles) {
     if (skin_mm != default_contact.skin_mm || stiffness_factor != default_contact.stiffness_factor)
       d += fmt::format("; the contact's skin is {:g} mm and its stiffness factor {:g} (the defaults: {:g} and {:g})", skin_mm,
                        stiffness_factor, default_contact.skin_mm, default_contact.stiffness_factor);
-    // The full model level (the FE needle, the penalty contact) goes unnamed; another needle model or contact law is said.
-    const std::string law = contact.value("law", std::string("penalty"));
-    const std::string needle_model =
-        scene.contains("needle") && scene["needle"].is_object() ? scene["needle"].value("model", std::string("fe")) : std::string("fe");
+    // The full model level's needle and contact (the FE needle, the penalty; a scene writes them only when not those) go
+    // unnamed, and a needle that does not take the coupling step with that contact (the rigid one, said elsewhere);
+    // another needle model or contact law is said in its registry's words, with the model level it makes.
+    const ModelLevel& full = *find_model_level(kReferenceModelLevel);
+    const std::string law = contact.value("law", full.contact_law);
+    const std::string needle_model = scene.contains("needle") && scene["needle"].is_object()
+                                         ? scene["needle"].value("model", full.needle_model)
+                                         : full.needle_model;
+    const ContactLawEntry& law_entry = contact_law(law);
+    const NeedleModelEntry& needle_entry = ::needle::needle_model(needle_model);
     const json solver = scene.value("solver", json::object());
     const bool mass_scaled = solver.value("tissue_mass_scaling", false) || solver.value("tissue_mass_scaling_dt_ms", 0.0) > 0;
     // Spherical kernel supports (the full model's) go unnamed; ellipsoids are said.
@@ -97,12 +106,15 @@ std::string describe_run_model(const json& scene, long particles) {
     const int rate_levels = solver.value("tissue_rate_levels", 0);
     const std::string multirate =
         rate_levels > 0 ? fmt::format(", the tissue away from the needle stepped at up to {} coupling steps (multi-rate)", 1 << rate_levels) : "";
-    if (law != "penalty" || (needle_model != "fe" && needle_model != "rigid"))
-      d += fmt::format("; the {} needle and the {} contact{}{}{}{}", needle_model == "implicit" ? "implicit linear" : needle_model,
-                       law == "projection" ? "kinematic (projection)" : law,
-                       mass_scaled ? ", the tissue selectively mass-scaled" : "",
-                       ellipsoids ? ", ellipsoidal kernel supports" : "", multirate,
-                       needle_model == "implicit" && law == "projection" && mass_scaled && ellipsoids && rate_levels == 3 ? " (--model fast)" : "");
+    std::string level_flag;  // the level these keys make, if any but the full one
+    for (const ModelLevel& level : model_levels())
+      if (level.name != full.name && level.needle_model == needle_model && level.contact_law == law &&
+          level.tissue_mass_scaling == mass_scaled && (level.support == SupportShape::ellipsoid) == ellipsoids &&
+          level.tissue_rate_levels == rate_levels)
+        level_flag = fmt::format(" (--model {})", level.name);
+    if (law != full.contact_law || needle_entry.takes_coupling_step)
+      d += fmt::format("; {} and {}{}{}{}{}", needle_entry.phrase, law_entry.phrase, mass_scaled ? ", the tissue selectively mass-scaled" : "",
+                       ellipsoids ? ", ellipsoidal kernel supports" : "", multirate, level_flag);
     else if (mass_scaled || ellipsoids || !multirate.empty())
       d += fmt::format("; {}{}", mass_scaled && ellipsoids ? "the tissue selectively mass-scaled, ellipsoidal kernel supports"
                                  : mass_scaled    ? "the tissue selectively mass-scaled"

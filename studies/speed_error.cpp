@@ -10,6 +10,7 @@
 #include "geometry/mesh_io.h"
 #include "plot/line_plot.h"
 #include "runs/json_file.h"
+#include "runs/model_levels.h"
 #include "runs/run_summary.h"
 
 namespace needle {
@@ -53,7 +54,7 @@ void fill_errors(std::vector<SpeedErrorCase>& cases, const nlohmann::json& refer
     if (reference_mm.contains(c.needle) && reference_mm[c.needle].is_number())
       c.error_vs_reference_mm = c.deflection_mm - reference_mm[c.needle].get<double>();
     for (const SpeedErrorCase& full : cases)
-      if (full.needle == c.needle && full.level == "full" && full.status == "finished") c.error_vs_full_mm = c.deflection_mm - full.deflection_mm;
+      if (full.needle == c.needle && full.level == kReferenceModelLevel && full.status == "finished") c.error_vs_full_mm = c.deflection_mm - full.deflection_mm;
   }
 }
 

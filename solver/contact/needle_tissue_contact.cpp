@@ -7,13 +7,13 @@
 #include <tuple>
 
 #include "core/input_error.h"
+#include "solver/contact/contact_laws.h"
 #include "core/parallel.h"
 
 namespace needle {
 
 void ContactOptions::validate(const std::string& where) const {
-  NEEDLE_REQUIRE(law == "penalty" || law == "projection",
-                 fmt::format("{}: law must be penalty or projection (got '{}')", where, law));
+  contact_law(law, where + ".law");  // InputError for an unknown law
   NEEDLE_REQUIRE(std::isfinite(friction) && friction >= 0, fmt::format("{}: friction must be zero or positive (got {})", where, friction));
   NEEDLE_REQUIRE(std::isfinite(stiffness_factor) && stiffness_factor > 0 && stiffness_factor <= 1e4,
                  fmt::format("{}: stiffness_factor must be in (0, 1e4] (got {})", where, stiffness_factor));

@@ -31,10 +31,12 @@ std::string known_names() {
 
 const std::vector<NeedleModelEntry>& needle_models() {
   static const std::vector<NeedleModelEntry> models = {
-      {"fe", "explicit T4/T10 finite elements with the driven base and the rigid cannula, subcycled in the tissue's step", true, true, make_fe},
-      {"implicit", "the same mesh, linear elastic, implicit Newmark steps on a factored matrix at the coupling step: no subcycling", false,
-       false, make_implicit},
-      {"rigid", "every node follows the drive: no deflection, no cannula, no step limit", false, false, make_rigid},
+      {"fe", "explicit T4/T10 finite elements with the driven base and the rigid cannula, subcycled in the tissue's step",
+       "the explicit FE needle", true, true, false, make_fe},
+      {"implicit", "the same mesh, linear elastic, implicit Newmark steps on a factored matrix at the coupling step: no subcycling",
+       "the implicit linear needle", false, false, true, make_implicit},
+      {"rigid", "every node follows the drive: no deflection, no cannula, no step limit", "the rigid needle", false, false, false,
+       make_rigid},
   };
   return models;
 }

@@ -19,10 +19,15 @@ struct NeedleModelInputs {
   NeedleDynamicsOptions options;
 };
 
+// What the rest of the code needs to know of a model is a trait on its entry, never its name.
 struct NeedleModelEntry {
   std::string name, description;
-  bool mass_scaled;  // it takes explicit steps, which selective mass scaling lengthens (a rigid needle takes any step)
-  bool runs_alone;   // a needle-alone run (no tissue) can drive it: the explicit FE needle with its cannula
+  std::string phrase;  // the model in a run's description, e.g. "the implicit linear needle"
+  bool mass_scaled;    // it takes explicit steps, which selective mass scaling lengthens (a rigid needle takes any step)
+  bool runs_alone;     // a needle-alone run (no tissue) can drive it: the explicit FE needle with its cannula
+  // It steps at the coupling step (solver.implicit_needle_step_ms), holding the contact's loads over its step: the
+  // contact law must keep them constant over it, and the tissue's mass scaling aims at a share of its step.
+  bool takes_coupling_step;
   std::unique_ptr<NeedleModel> (*make)(const NeedleModelInputs& inputs);
 };
 

@@ -6,6 +6,8 @@
 
 #include "mesher/needle_mesher.h"
 #include "solver/contact/contact_surface.h"
+#include "core/input_error.h"
+#include "solver/contact/contact_laws.h"
 #include "solver/contact/penalty_contact.h"
 
 using namespace needle;
@@ -196,4 +198,29 @@ TEST_CASE("Contact surface: pull-back undoes a rigid motion of the needle, and t
     ++checked;
   }
   CHECK(checked == 4);
+}
+
+TEST_CASE("Contact laws are made by name with their traits, an unknown name lists the known ones", "[solver][contact][gmsh]") {
+  // Each entry makes the law it names; the trait the coupled step and the model check read: only the kinematic law keeps
+  // the needle's load constant over its step (one impulse a step), which the implicit needle needs.
+  const TetMesh mesh = rod_mesh();
+  const ContactSurface surface(mesh);
+  const TissueParticles p = one_particle({-1.0, kRadius + 0.5, 0.0}, Eigen::Vector3d::Zero());
+  for (const ContactLawEntry& entry : contact_laws()) {
+    ContactOptions options;
+    options.law = entry.name;
+    CHECK(make_tissue_contact(surface, p, TissueMaterial{}, options)->law() == entry.name);
+    CHECK(&contact_law(entry.name) == &entry);
+  }
+  CHECK_FALSE(contact_law("penalty").constant_over_needle_step);
+  CHECK(contact_law("projection").constant_over_needle_step);
+  try {
+    contact_law("spring", "scene.json:3: tissue.contact.law");
+    FAIL("an unknown law was found");
+  } catch (const InputError& e) {
+    CHECK(std::string(e.what()) == "scene.json:3: tissue.contact.law: must be penalty or projection (got 'spring')");
+  }
+  ContactOptions bad;
+  bad.law = "spring";
+  CHECK_THROWS_WITH(bad.validate(), "contact.law: must be penalty or projection (got 'spring')");
 }

@@ -55,6 +55,16 @@ TEST_CASE("Needle models are made by name, an unknown name lists the known ones"
   } catch (const InputError& e) {
     CHECK(std::string(e.what()) == "needle.model: unknown needle model 'beam' (known: fe, implicit, rigid)");
   }
+  // The traits the run code reads instead of names: only the FE needle runs alone (with its cannula), only the implicit
+  // one takes the coupling step (and needs a contact load constant over it), only the explicit one is mass-scaled.
+  CHECK(needle_model("fe").runs_alone);
+  CHECK_FALSE(needle_model("implicit").runs_alone);
+  CHECK_FALSE(needle_model("rigid").runs_alone);
+  CHECK(needle_model("implicit").takes_coupling_step);
+  CHECK_FALSE(needle_model("fe").takes_coupling_step);
+  CHECK_FALSE(needle_model("rigid").takes_coupling_step);
+  CHECK(needle_model("fe").mass_scaled);
+  CHECK(needle_model("implicit").phrase == "the implicit linear needle");
 }
 
 TEST_CASE("A free FE needle under a mass-proportional load moves as a rigid body",
