@@ -99,6 +99,8 @@ int main(int argc, char** argv) {
   } catch (const needle::StudyIncomplete& e) {
     fmt::print(stderr, "needle: {}\n", one_line(e.what()));
     return 3;
+  } catch (const needle::PassedExitStatus& e) {
+    return e.code;
   } catch (const std::filesystem::filesystem_error& e) {
     // The environment, not the input: a folder that cannot be made or written, a disk that is full.
     fmt::print(stderr, "needle: cannot read or write a file: {}\n", one_line(e.what()));

@@ -10,6 +10,7 @@
 #include "core/input_error.h"
 #include "core/parallel.h"
 #include "core/solver_error.h"
+#include "sweeps/mpirun_launcher.h"
 #include "sweeps/sweep_executor.h"
 #include "sweeps/sweep_mpi.h"
 #include "sweeps/sweep_plan.h"
@@ -26,7 +27,7 @@ namespace {
 
 struct SweepOptions {
   std::string file, out_dir;
-  int jobs = 1, threads = 0, task_index = -1;
+  int jobs = 1, threads = 0, task_index = -1, mpi_ranks = 0;
   bool collect = false, count = false, quiet = false, allow_other_code = false;
 };
 
@@ -62,6 +63,18 @@ void run(const SweepOptions& o) {
   NEEDLE_REQUIRE(!o.out_dir.empty(), "--out: give the sweep's folder");
   NEEDLE_REQUIRE(o.jobs >= 1 && o.jobs <= 256, fmt::format("--jobs must be from 1 to 256 (got {})", o.jobs));
   const fs::path dir(o.out_dir);
+  if (o.mpi_ranks > 0) {  // this same sweep under mpirun, started here so that Ctrl-C exits 130 (mpirun_launcher.h)
+    NEEDLE_REQUIRE(!o.collect && o.task_index < 0 && o.jobs == 1, "--mpi runs the whole sweep on MPI ranks: give it without --jobs, --task-index or --collect");
+    NEEDLE_REQUIRE(!launched_by_mpi(), "--mpi starts mpirun itself: run `needle sweep --mpi N` without mpirun");
+    NEEDLE_REQUIRE(mpi_available(), "--mpi: this needle was built without MPI (install libopenmpi-dev and build again)");
+    std::vector<std::string> args = {"sweep", fs::absolute(o.file).string(), "--out", fs::absolute(dir).string()};
+    if (o.threads > 0) args.insert(args.end(), {"--threads", std::to_string(o.threads)});
+    if (o.quiet) args.emplace_back("--quiet");
+    if (o.allow_other_code) args.emplace_back("--allow-other-code");
+    const int status = run_sweep_under_mpirun(args, o.mpi_ranks, dir);
+    if (status != 0) throw PassedExitStatus{status};
+    return;
+  }
   const nlohmann::json stored_plan = sweep_plan_to_json(plan);
   if (o.collect) {
     NEEDLE_REQUIRE(fs::exists(dir / "sweep_plan.json"), fmt::format("--collect: {} holds no sweep (no sweep_plan.json)", dir.string()));
@@ -132,6 +145,9 @@ void add_sweep_command(CLI::App& app) {
   c->add_option("file", o->file, "Sweep file (JSON): base scene, design variables, design")->required();
   c->add_option("--out", o->out_dir, "The sweep's folder (created; a folder of the same sweep goes on where it stopped)");
   c->add_option("--jobs", o->jobs, "Worker processes on this machine (default 1)");
+  c->add_option("--mpi", o->mpi_ranks,
+                "Run on N MPI ranks (N - 1 workers) by starting mpirun itself, so that Ctrl-C exits 130 as with --jobs "
+                "(`mpirun -n N needle sweep` exits 1 when interrupted; docs/sweeps.md)");
   c->add_option("--threads", o->threads, "Worker threads of each case (default: the cores shared among the jobs)")->check(count_check());
   c->add_option("--task-index", o->task_index, "Run only this case (a batch array's task; default: SLURM_ARRAY_TASK_ID when set)")
       ->check(count_check());

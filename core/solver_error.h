@@ -19,4 +19,10 @@ struct StudyIncomplete : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// The exit status of a command this one ran for the user (mpirun, for `needle sweep --mpi`), which has said why
+// already: main returns it without a line of its own.
+struct PassedExitStatus {
+  int code;
+};
+
 }  // namespace needle

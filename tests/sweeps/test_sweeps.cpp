@@ -161,6 +161,20 @@ TEST_CASE("needle sweep gives one table on worker processes, on MPI ranks and as
   CHECK(mpi.find("on 2 MPI ranks") != std::string::npos);
   CHECK(deflections(dir / "mpi") == reference);  // bit for bit
 
+  // --mpi 2: needle starts mpirun itself (mpirun_launcher.h), the same table bit for bit.
+  const Result launched = run("sweep " + sweep + " --out " + (dir / "mpi_launched").string() + " --mpi 2", true);
+  INFO(launched.out);
+  CHECK(launched.exit_code == 0);
+  CHECK(launched.out.find("on 2 MPI ranks") != std::string::npos);
+  CHECK(deflections(dir / "mpi_launched") == reference);
+  for (const char* flags : {" --mpi 2 --jobs 2", " --mpi 2 --collect"}) {
+    const Result bad = run("sweep " + sweep + " --out " + (dir / "mpi_bad").string() + flags, true);
+    INFO(flags << ": " << bad.out);
+    CHECK(bad.exit_code == 2);
+    CHECK(bad.out.find("--mpi runs the whole sweep on MPI ranks") != std::string::npos);
+    CHECK(!fs::exists(dir / "mpi_bad"));
+  }
+
   // One rank alone runs the cases itself, and says how long each took (issue 51: it said 0 s for cases of 1.4 s).
   const std::string mpi1 = stderr_of("mpirun --allow-run-as-root --oversubscribe -n 1 " + std::string(NEEDLE_BINARY) + " sweep " + sweep + " --out " +
                                      (dir / "mpi1").string() + "; echo exit=$?");
@@ -293,6 +307,31 @@ TEST_CASE("A sweep interrupted midway loses no finished case and repeats none wh
   const Result other = run("sweep " + (dir / "other.json").string() + " --out " + out.string(), true);
   CHECK(other.exit_code == 2);
   CHECK(other.out.find("holds another study") != std::string::npos);
+}
+
+TEST_CASE("needle sweep --mpi interrupted exits 130 and leaves no rank running; killed, it leaves no job; its rerun goes on",
+          "[sweeps][gmsh][lspg][slow]") {
+  // Under `mpirun -n N needle sweep`, Ctrl-C exits 1 (OpenMPI's mpirun, whatever its ranks return); --mpi starts mpirun
+  // in a process group of its own and reports the interruption itself (issue 51).
+  const fs::path dir = fresh_folder("sweep_mpi_interrupt");
+  write_tiny_scene(dir);
+  write(dir / "sweep.json", R"({"base": {"scene": "scene.json"}, "model": "fast", "variables": {"tissue.friction": {"from": 0.05, "to": 0.4, "count": 8}}})");
+  for (const char* signal : {"INT", "KILL"}) {
+    const fs::path out = dir / (std::string("out_") + signal);
+    const std::string script = std::string(NEEDLE_BINARY) + " sweep " + (dir / "sweep.json").string() + " --out " + out.string() +
+                               " --mpi 2 --quiet & pid=$!; while [ ! -f " + (out / "cases" / "case_0000" / "case.json").string() +
+                               " ]; do sleep 0.05; done; kill -" + signal + " $pid; wait $pid; echo exit=$?; sleep 2; " +
+                               "echo left=$(pgrep -f -- \"^[^ ]*(needle|mpirun|orted) .*" + out.filename().string() + "\" | wc -l)";
+    const std::string first = stderr_of("bash -c '" + script + "' 2>&1");
+    INFO(signal << ": " << first);
+    CHECK(first.find(std::string(signal) == "INT" ? "exit=130" : "exit=137") != std::string::npos);
+    if (std::string(signal) == "INT") CHECK(first.find("the same command goes on from there") != std::string::npos);
+    CHECK(first.find("left=0") != std::string::npos);  // no mpirun, no rank
+    const Result again = run("sweep " + (dir / "sweep.json").string() + " --out " + out.string() + " --mpi 2", true);
+    INFO(again.out);
+    CHECK(again.exit_code == 0);
+    CHECK(read_json(out / "sweep.json")["counts"]["finished"] == 8);
+  }
 }
 
 TEST_CASE("A sweep killed by SIGKILL leaves no worker running, and its rerun finishes every case with none failed", "[sweeps][gmsh][lspg][slow]") {
