@@ -39,18 +39,23 @@ ReplicaScatter replica_scatter(const std::vector<NeedleOutcome>& runs, const std
     out.needles.push_back(s);
   }
 
-  // Each replica's runs, with this report's where it has none. A target whose numbers come out as this
-  // report's did not see the replica (it lacks the target's needles), so it is not counted for it.
+  // Each replica's runs, with this report's where it has none. A target on one needle the replica lacks, or a target
+  // on several when it has none of them, did not see the replica and is not counted for it. (Counted by the needles,
+  // not by whether the target's printed numbers differ: a replica may round to this report's numbers.)
   out.targets.resize(here.size());
   for (const ModelResults& m : replicas) {
     std::vector<NeedleOutcome> merged;
+    std::vector<std::string> has;  // the needles the replica ran
     for (const NeedleOutcome& r : runs) {
       const NeedleOutcome* o = find_outcome(m.needles, r.name);
-      merged.push_back(o && std::isfinite(o->deflection_mm) ? *o : r);
+      const bool own = o && std::isfinite(o->deflection_mm);
+      merged.push_back(own ? *o : r);
+      if (own) has.push_back(r.name);
     }
     const std::vector<PaperTarget> there = evaluate_paper_targets(merged, reference);
     for (size_t i = 0; i < here.size() && i < there.size(); ++i) {
-      if (!there[i].checked || there[i].numbers == here[i].numbers) continue;
+      const bool saw = there[i].needle.empty() ? !has.empty() : std::find(has.begin(), has.end(), there[i].needle) != has.end();
+      if (!there[i].checked || !saw) continue;
       ++out.targets[i].checked;
       if (there[i].met)
         ++out.targets[i].met;

@@ -474,6 +474,25 @@ TEST_CASE("needle paper --report-only says when its runs kept the lip below the 
                                           "is (no lip release)") != std::string::npos);
 }
 
+TEST_CASE("needle paper counts a replica's target even where the replica's numbers round to this report's", "[apps][paper][slow]") {
+  // Issue 47's report showed AMB's 0.1 mm target 'met in 0 of 2' over three replicas: a replica whose AMB printed as this
+  // report's (-0.011) was taken for one that had not run AMB. The replica here ran AMB (+0.2001: +0.200 printed, as here).
+  const fs::path dir = fresh("replica_round_this"), c = fresh("replica_round_c");
+  for (const auto& [name, r] : std::map<std::string, FakeRun>{{"SB", {-1.10, 0.90}}, {"LMB", {0.22, 0.95}}, {"AMB", {0.20, 0.40}}, {"HMB", {1.20, 0.10}}})
+    write_run(dir, name, r);
+  write_run(c, "AMB", {0.2001, 0.40});
+  REQUIRE(run("paper --report-only --no-tips --quiet --tissue-E-MPa 0.05 --needles AMB --out " + c.string(), true).exit_code == 0);
+  const auto result = run("paper --report-only --no-tips --quiet --tissue-E-MPa 0.05 --out " + dir.string() + " --replica \"C=" +
+                              (c / "results.json").string() + "\"",
+                          true);
+  INFO(result.out);
+  REQUIRE(result.exit_code == 0);
+  const std::string md = read_text(dir / "report.md");
+  INFO(md);
+  CHECK(md.find("| AMB: abs(delta - delta_experiment) <= 0.1 mm | met | met in 1 of 1 |") != std::string::npos);
+  CHECK(md.find("| SB: abs(delta - delta_experiment) <= 0.1 mm | met | the same in every replica") != std::string::npos);  // C has no SB
+}
+
 TEST_CASE("needle paper names a parameter fitted on HMB, with its leave-one-out errors, only where the runs use its value",
           "[apps][paper][slow]") {
   // The record as studies/sensitivity/second_parameter.py --record writes it: the crushed lip's depth fitted on HMB.
