@@ -309,7 +309,7 @@ TEST_CASE("A sweep interrupted midway loses no finished case and repeats none wh
   CHECK(other.out.find("holds another study") != std::string::npos);
 }
 
-TEST_CASE("needle sweep --mpi interrupted exits 130 and leaves no rank running; killed, it leaves no job; its rerun goes on",
+TEST_CASE("needle sweep --mpi interrupted exits 130 and leaves no rank running, killed it leaves no job, and its rerun goes on",
           "[sweeps][gmsh][lspg][slow]") {
   // Under `mpirun -n N needle sweep`, Ctrl-C exits 1 (OpenMPI's mpirun, whatever its ranks return); --mpi starts mpirun
   // in a process group of its own and reports the interruption itself (issue 51).
