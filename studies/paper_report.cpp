@@ -36,7 +36,9 @@ namespace {
 // needle's run here uses the record's value (the record: studies/sensitivity/second_parameter.py --record).
 struct FittedParameter {
   std::string needle, name;  // empty: nothing but E is fitted in these runs
-  std::string section;       // the report's section
+  std::string key;
+  double value = kNaN;
+  std::string section;  // the report's section
 };
 
 FittedParameter fitted_parameter(const PaperReportInput& in, const fs::path& dir) {
@@ -68,7 +70,7 @@ FittedParameter fitted_parameter(const PaperReportInput& in, const fs::path& dir
                       h.value("at_range_end", false) ? " (range end)" : "", h.value("prediction_mm", kNaN),
                       h.value("prediction_mm", kNaN) - h.value("error_mm", kNaN), h.value("error_mm", kNaN));
   md += "\n";
-  return {needle, record.value("name", key), md};
+  return {needle, record.value("name", key), key, value, md};
 }
 
 // What one needle's run folder says.
@@ -352,6 +354,10 @@ void write_paper_report(const PaperReportInput& in) {
                   {"reference", fs::proximate(in.reference_path).string()},
                   {"provenance", provenance_json()}};
   for (const ModelResults& m : replicas) results["replicas"].push_back({{"label", m.label}, {"results", m.path}});
+  const FittedParameter fitted = fitted_parameter(in, dir);
+  if (!fitted.needle.empty())
+    results["fitted_parameter"] = {{"key", fitted.key}, {"name", fitted.name}, {"value", fitted.value}, {"fitted_on", fitted.needle},
+                                   {"record", fs::proximate(in.fitted_path).string()}};
   if (const json observations = paper_observations_json(observed); !observations.empty()) results["observations"] = observations;
 
   // The pictures.
@@ -408,7 +414,6 @@ void write_paper_report(const PaperReportInput& in) {
                           "with the same flags before reading the others as predictions.\n\n",
                           r.name, r.deflection_mm, cal_deflection);
   }
-  const FittedParameter fitted = fitted_parameter(in, dir);
   md += fitted.section;
   md += "## Deflection at the end of insertion (mm, +y up: the groove side)\n\n";
   md += "| needle | d_a (mm) | this toolkit | experiment | LS-DYNA (paper) | ours - experiment | status | run time |\n";

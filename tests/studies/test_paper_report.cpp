@@ -519,6 +519,9 @@ TEST_CASE("needle paper names a parameter fitted on HMB, with its leave-one-out 
   CHECK(md.find("| met (by a fit: the crushed lip's depth is fitted on HMB) |") != std::string::npos);
   CHECK(md.find("by a fit") == md.rfind("by a fit"));
   CHECK(md.find("--fitted " + record_path.string()) != std::string::npos);  // the command that regenerates it
+  const json fitted = read_json(dir / "results.json")["fitted_parameter"];
+  CHECK(fitted["fitted_on"] == "HMB");
+  CHECK(fitted["value"].get<double>() == needle::kSceneCrushedLipDepthMm);
 
   // Runs with the whole lip crushed (the default of 2026-11-27): nothing here is fitted but E, and the lip is said.
   const json whole = {{"tissue", {{"spacing_mm", 0.4}, {"path_refinement", 2}, {"path_half_width_mm", 1.2},
@@ -528,6 +531,7 @@ TEST_CASE("needle paper names a parameter fitted on HMB, with its leave-one-out 
   REQUIRE(result.exit_code == 0);
   md = read_text(dir / "report.md");
   CHECK(md.find("One more parameter fitted") == std::string::npos);
+  CHECK(!read_json(dir / "results.json").contains("fitted_parameter"));
   CHECK(md.find("the whole lip below the tip point is crushed (lip release)") != std::string::npos);
 }
 
