@@ -125,12 +125,6 @@ def ratios_from(deltas, lips, values=None, lip_depth=False):
     return ratios
 
 
-def read_ratios(out, key, values):
-    """{value: {needle: ratio to SB}} for the values whose four needles finished; and the missing ones' reasons."""
-    deltas, lips, problems = read_runs([os.path.join(out, "sweep")])
-    return ratios_from(deltas, lips, values), problems
-
-
 def interpolate(ratios, needle, value):
     xs = sorted(ratios)
     if value <= xs[0]:
