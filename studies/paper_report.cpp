@@ -11,6 +11,7 @@
 
 #include "runs/csv_table.h"
 #include "runs/json_file.h"
+#include "runs/json_lines.h"
 #include "runs/provenance_json.h"
 #include "runs/run_summary.h"
 #include "studies/paper_observations.h"
@@ -51,7 +52,7 @@ FittedParameter fitted_parameter(const PaperReportInput& in, const fs::path& dir
   std::string pointer;
   for (size_t start = 0; start <= key.size();) {
     const size_t end = std::min(key.find('.', start), key.size());
-    pointer += "/" + key.substr(start, end - start);
+    pointer += "/" + json_pointer_token(key.substr(start, end - start));
     start = end + 1;
   }
   const json scene = read_json_file(scene_path.string(), "run scene");

@@ -63,6 +63,14 @@ std::string read_text(const fs::path& path) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
+// `needle paper --report-only --no-tips --quiet ARGS --out DIR`, which must succeed; the report it wrote.
+std::string report_only(const fs::path& dir, const std::string& args) {
+  const auto result = run("paper --report-only --no-tips --quiet " + args + " --out " + dir.string(), true);
+  INFO(result.out);
+  REQUIRE(result.exit_code == 0);
+  return read_text(dir / "report.md");
+}
+
 }  // namespace
 
 TEST_CASE("needle paper --report-only: runs matching the experiment meet every target", "[apps][paper][slow]") {
@@ -259,12 +267,8 @@ TEST_CASE("needle paper --compare sets another model's results beside this one, 
   CHECK(bad.out.find("no file '/nonexistent/results.json'") != std::string::npos);
   CHECK(!fs::exists(dir / "report.md"));
 
-  const auto result = run("paper --report-only --no-tips --quiet --tissue-E-MPa 0.05 --label \"fine model\" --out " + dir.string() + " --compare \"coarse model=" +
-                              (other / "results.json").string() + "\"",
-                          true);
-  INFO(result.out);
-  REQUIRE(result.exit_code == 0);
-  const std::string md = read_text(dir / "report.md");
+  const std::string md =
+      report_only(dir, "--tissue-E-MPa 0.05 --label \"fine model\" --compare \"coarse model=" + (other / "results.json").string() + "\"");
   CHECK(md.find("## The same needles under other models") != std::string::npos);
   // delta / delta_SB of each model: 0.16 / -0.30, 0.02 / -0.30, 0.50 / -0.30; ours 0.12 / -1.10 ...
   CHECK(md.find("| 0.2 | -0.300 | +0.160 (-0.53) | +0.020 (-0.07) | +0.500 (-1.67) | 1 of 6 |") != std::string::npos);
@@ -482,12 +486,7 @@ TEST_CASE("needle paper counts a replica's target even where the replica's numbe
     write_run(dir, name, r);
   write_run(c, "AMB", {0.2001, 0.40});
   REQUIRE(run("paper --report-only --no-tips --quiet --tissue-E-MPa 0.05 --needles AMB --out " + c.string(), true).exit_code == 0);
-  const auto result = run("paper --report-only --no-tips --quiet --tissue-E-MPa 0.05 --out " + dir.string() + " --replica \"C=" +
-                              (c / "results.json").string() + "\"",
-                          true);
-  INFO(result.out);
-  REQUIRE(result.exit_code == 0);
-  const std::string md = read_text(dir / "report.md");
+  const std::string md = report_only(dir, "--tissue-E-MPa 0.05 --replica \"C=" + (c / "results.json").string() + "\"");
   INFO(md);
   CHECK(md.find("| AMB: abs(delta - delta_experiment) <= 0.1 mm | met | met in 1 of 1 |") != std::string::npos);
   CHECK(md.find("| SB: abs(delta - delta_experiment) <= 0.1 mm | met | the same in every replica") != std::string::npos);  // C has no SB
@@ -505,11 +504,7 @@ TEST_CASE("needle paper names a parameter fitted on HMB, with its leave-one-out 
                                            {"prediction_mm", -0.011}, {"error_mm", -0.251}}}}};
   const fs::path record_path = dir / "fit.json";
   std::ofstream(record_path) << record.dump(2);
-  const std::string command = "paper --report-only --no-tips --quiet --fitted " + record_path.string() + " --out " + dir.string();
-  auto result = run(command, true);
-  INFO(result.out);
-  REQUIRE(result.exit_code == 0);
-  std::string md = read_text(dir / "report.md");
+  std::string md = report_only(dir, "--fitted " + record_path.string());
   CHECK(md.find("## One more parameter fitted to a needle: the crushed lip's depth, on HMB alone") != std::string::npos);
   CHECK(md.find("`tissue.contact.lip_release_depth_mm` = 0.45 mm in these runs is fitted on HMB (0.4521 fitted, rounded") != std::string::npos);
   // The measured value is the prediction less its error: -0.011 + 0.251.
@@ -527,9 +522,7 @@ TEST_CASE("needle paper names a parameter fitted on HMB, with its leave-one-out 
   const json whole = {{"tissue", {{"spacing_mm", 0.4}, {"path_refinement", 2}, {"path_half_width_mm", 1.2},
                                   {"contact", {{"cuts_bonds", true}, {"lip_release_mode", "crushed"}, {"lip_release_depth_mm", "whole lip"}}}}}};
   for (const char* name : {"SB", "LMB", "AMB", "HMB"}) std::ofstream(dir / "runs" / name / "scene.json") << whole.dump(2);
-  result = run(command, true);
-  REQUIRE(result.exit_code == 0);
-  md = read_text(dir / "report.md");
+  md = report_only(dir, "--fitted " + record_path.string());
   CHECK(md.find("One more parameter fitted") == std::string::npos);
   CHECK(!read_json(dir / "results.json").contains("fitted_parameter"));
   CHECK(md.find("the whole lip below the tip point is crushed (lip release)") != std::string::npos);
