@@ -7,7 +7,7 @@
 // updated from the relative deformation gradient F_n+1 F_n^-1 of the step (tissue_material.h). Force on particle j:
 //   f_j = - sum_i V_i P_i grad Psi_j(X_i) + stabilization,   P = J sigma F^-T (first Piola-Kirchhoff),
 // gathered through the transposed shape functions, so results do not depend on the thread count (the gather and the
-// multi-rate levels: spg_rate_levels.cpp; the stable step: spg_stable_step.cpp).
+// multi-rate levels: spg_rate_levels.cpp; the bonds breaking: spg_bond_failure.cpp; the stable step: spg_stable_step.cpp).
 #include <Eigen/Dense>
 #include <cstdint>
 #include <limits>
