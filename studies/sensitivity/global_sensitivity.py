@@ -31,6 +31,9 @@ POOLED_SD_MM = 0.105  # the paper's ANOVA: F = 1220.4 with 3 and 36 degrees of f
 # The measured plateau: AMB - LMB = +0.09 +- 0.05 mm (p = 0.457). Ours, with SB calibrated: -1.14 mm x (ratio_AMB - ratio_LMB).
 PLATEAU = "calibrated_AMB_minus_LMB_mm"
 MIN_Q2 = 0.5  # below it a surrogate does not predict left-out points well enough for its extremes to be claimed
+# ... unless the runs themselves scatter: a surrogate that misses a left-out point by no more than this many of the
+# replicas' standard deviations predicts it about as well as the same run on a shifted lattice would.
+RMSE_OVER_SCATTER = 1.5
 
 
 class StudyError(Exception):
@@ -272,9 +275,54 @@ def hsic_indices(study, rows, response, permutations=2000, seed=1):
     return [(factors[j]["name"], float(r2[j]), float(p[j])) for j in range(len(factors))]
 
 
-def fit_kriging(study, rows, response, factor_names):
+def replica_scatter(study, root):
+    """{response: its standard deviation over a paper report and its replicas}: the run-to-run scatter of each response
+    (the same model, the lattice shifted, other rounding), from the study's 'scatter_from' (a `needle paper` results.json
+    whose 'replicas' list the others; paths relative to the repository). {} without it."""
+    if "scatter_from" not in study:
+        return {}
+    main = os.path.join(root, study["scatter_from"])
+    try:
+        with open(main) as f:
+            reports = [json.load(f)]
+        for replica in reports[0].get("replicas", []):
+            with open(os.path.join(root, replica["results"])) as f:
+                reports.append(json.load(f))
+    except (OSError, json.JSONDecodeError, KeyError, TypeError) as e:
+        raise StudyError(f"scatter_from {study['scatter_from']}: {e}")
+    samples = {}
+    for report in reports:
+        needles = report.get("needles", {})
+        delta = {n: needles[n]["deflection_mm"] for n in study["needles"]
+                 if n in needles and needles[n].get("status") == "finished" and needles[n].get("deflection_mm") is not None}
+        if len(delta) != len(study["needles"]):
+            continue  # a report without every needle of the study says nothing of the ratios
+        values = {f"delta_{n}_mm": d for n, d in delta.items()}
+        values.update({f"ratio_{n}": d / delta["SB"] for n, d in delta.items() if n != "SB"})
+        if "LMB" in delta and "AMB" in delta:
+            values[PLATEAU] = MEASURED_MM["SB"] * (values["ratio_AMB"] - values["ratio_LMB"])
+        for k, v in values.items():
+            samples.setdefault(k, []).append(v)
+    if not samples or min(len(v) for v in samples.values()) < 2:
+        raise StudyError(f"scatter_from {study['scatter_from']}: fewer than two reports with every needle of the study")
+    out = {}
+    for k, v in samples.items():
+        mean = sum(v) / len(v)
+        out[k] = math.sqrt(sum((x - mean) ** 2 for x in v) / (len(v) - 1))
+    return out
+
+
+def surrogate_validated(q2, rmse, scatter_sd):
+    """A surrogate is validated when it predicts left-out points (Q2 >= MIN_Q2), or misses them by no more than
+    RMSE_OVER_SCATTER of the runs' own scatter (then the response's spread over the box is mostly that scatter)."""
+    return q2 >= MIN_Q2 or (scatter_sd is not None and scatter_sd > 0 and rmse <= RMSE_OVER_SCATTER * scatter_sd)
+
+
+def fit_kriging(study, rows, response, factor_names, noise_sd=None):
     """A kriging surrogate of the response on the named factors (constant trend, squared-exponential ARD, each factor
-    scaled to [0, 1] over its range) and its leave-one-out Q2 and RMSE: (model, factors, q2, rmse)."""
+    scaled to [0, 1] over its range) and its leave-one-out Q2 and RMSE: (model, factors, q2, rmse). With noise_sd (the
+    runs' own scatter), each run is taken as the response plus that noise: the surrogate smooths rather than
+    interpolates, and its extremes are those of the response, not of one run's rounding."""
     import openturns as ot
     ot.Log.Show(ot.Log.NONE)  # OpenTURNS warns each time it narrows the correlation lengths' bounds to the data
     factors = [f for f in study["factors"] if f["name"] in factor_names]
@@ -286,6 +334,8 @@ def fit_kriging(study, rows, response, factor_names):
         basis = ot.ConstantBasisFactory(dim).build()
         algo = ot.KrigingAlgorithm(xs, ys, ot.SquaredExponential([0.5] * dim, [1.0]), basis)
         algo.setOptimizationBounds(ot.Interval([0.05] * dim, [10.0] * dim))
+        if noise_sd:
+            algo.setNoise([noise_sd * noise_sd] * xs.getSize())
         algo.run()
         return algo.getResult().getMetaModel()
 
@@ -375,10 +425,10 @@ def box_grid(factors, size=4096):
     return grid
 
 
-def kriging_surrogate(study, rows, response, factor_names):
+def kriging_surrogate(study, rows, response, factor_names, noise_sd=None):
     """The response's kriging surrogate on the named factors, its leave-one-out Q2, and its lowest and highest value
     over the factors' box (the other factors averaged out)."""
-    model, factors, q2, rmse = fit_kriging(study, rows, response, factor_names)
+    model, factors, q2, rmse = fit_kriging(study, rows, response, factor_names, noise_sd)
     grid = box_grid(factors)
     values = model(grid)
 
@@ -388,7 +438,8 @@ def kriging_surrogate(study, rows, response, factor_names):
     k_min = min(range(grid.getSize()), key=lambda i: values[i][0])
     k_max = max(range(grid.getSize()), key=lambda i: values[i][0])
     return {"response": response, "factors": [f["name"] for f in factors], "points": len(rows),
-            "leave_one_out_q2": q2, "leave_one_out_rmse": rmse,
+            "leave_one_out_q2": q2, "leave_one_out_rmse": rmse, "replica_sd": noise_sd,
+            "validated": surrogate_validated(q2, rmse, noise_sd),
             "box_min": {"value": values[k_min][0], "at": at(k_min)},
             "box_max": {"value": values[k_max][0], "at": at(k_max)},
             "observed_min": min(r[response] for r in rows), "observed_max": max(r[response] for r in rows)}
@@ -400,11 +451,12 @@ def calibrated_errors(ratios):
     return {n: MEASURED_MM["SB"] * r - MEASURED_MM[n] for n, r in ratios.items()}
 
 
-def joint_search(study, rows, factor_names):
+def joint_search(study, rows, factor_names, scatter=None):
     """The point of the box (the named factors; the others averaged out) whose surrogate ratios, calibrated on SB, come
     nearest the experiment: the largest |error| over the multi-bevel needles is the smallest."""
+    scatter = scatter or {}
     needles = [n for n in study["needles"] if n != "SB"]
-    fits = {n: fit_kriging(study, rows, f"ratio_{n}", factor_names) for n in needles}
+    fits = {n: fit_kriging(study, rows, f"ratio_{n}", factor_names, scatter.get(f"ratio_{n}")) for n in needles}
     factors = fits[needles[0]][1]
     grid = box_grid(factors, 8192)
     values = {n: fits[n][0](grid) for n in needles}
@@ -416,6 +468,7 @@ def joint_search(study, rows, factor_names):
     ratios = {n: values[n][best][0] for n in needles}
     return {"factors": [f["name"] for f in factors],
             "leave_one_out_q2": {n: fits[n][2] for n in needles}, "leave_one_out_rmse": {n: fits[n][3] for n in needles},
+            "validated": all(surrogate_validated(fits[n][2], fits[n][3], scatter.get(f"ratio_{n}")) for n in needles),
             "best_at": {f["name"]: value_at_unit(f, float(grid[best, j])) for j, f in enumerate(factors)},
             "best_ratios": ratios, "best_calibrated_errors_mm": calibrated_errors(ratios), "best_max_error_mm": best_score}
 
@@ -479,7 +532,8 @@ def plot_scatter(path, study, rows, table):
     plt.close(fig)
 
 
-def analyze(study, out, permutations=2000, top=3):
+def analyze(study, out, permutations=2000, top=3, root=None):
+    scatter = replica_scatter(study, root or os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")))
     records = read_points(study, out)
     rows, incomplete = complete_rows(study, records)
     folder = os.path.join(out, "analysis")
@@ -498,20 +552,17 @@ def analyze(study, out, permutations=2000, top=3):
     surrogates = []
     for r in [x for x in resp if x.startswith("ratio_") or x == PLATEAU]:
         names = [n for n, _ in sorted(table[r].items(), key=lambda kv: -kv[1][0])[:top]]
-        surrogates.append(kriging_surrogate(study, rows, r, names))
+        surrogates.append(kriging_surrogate(study, rows, r, names, scatter.get(r)))
     chaos = [chaos_or_none(study, rows, r) for r in resp if r.startswith("ratio_")]
     chaos = [c for c in chaos if c]
     joint_factors = []
     for s_ in surrogates:
         joint_factors += [n for n in s_["factors"] if n not in joint_factors]
-    joint = joint_search(study, rows, joint_factors)
+    joint = joint_search(study, rows, joint_factors, scatter)
     nearest = min(rows, key=lambda r: r["calibrated_max_error_mm"])
-    joint["validated"] = min(joint["leave_one_out_q2"].values()) >= MIN_Q2
-    for s_ in surrogates:
-        s_["validated"] = s_["leave_one_out_q2"] >= MIN_Q2
     result = {"points_complete": len(rows), "points_incomplete": [{"point": p, "needles": s} for p, s in incomplete],
               "responses": resp, "hsic": {r: {n: {"r2_hsic": v[0], "p_value": v[1]} for n, v in table[r].items()} for r in resp},
-              "surrogates": surrogates, "chaos": chaos, "joint": joint, "nearest_run_point": nearest, "measured_mm": MEASURED_MM}
+              "replica_sd": scatter, "surrogates": surrogates, "chaos": chaos, "joint": joint, "nearest_run_point": nearest, "measured_mm": MEASURED_MM}
     with open(os.path.join(folder, "surrogate.json.tmp"), "w") as f:
         json.dump(result, f, indent=1)
     os.replace(os.path.join(folder, "surrogate.json.tmp"), os.path.join(folder, "surrogate.json"))
@@ -534,15 +585,18 @@ def analyze(study, out, permutations=2000, top=3):
     md.append("Kriging surrogates of the ratios to SB and of the plateau AMB - LMB on their three most influential factors (the others "
               "averaged out):")
     md.append("")
-    md.append(f"(box min..max in brackets where the surrogate's leave-one-out Q2 is below {MIN_Q2}: not validated)")
+    md.append(f"(box min..max in brackets where the surrogate is not validated: its leave-one-out Q2 is below {MIN_Q2} and its leave-one-out "
+              f"RMSE above {RMSE_OVER_SCATTER} times the replicas' standard deviation, where the study names replicas"
+              + (f" ({study['scatter_from']} and its replicas; the kriging takes that scatter as the runs' noise)" if scatter else "") + ")")
     md.append("")
-    md.append("| response | factors | LOO Q2 | LOO RMSE | observed min..max | box min..max | experiment |")
-    md.append("|---|---|---|---|---|---|---|")
+    md.append("| response | factors | LOO Q2 | LOO RMSE | replicas' SD | observed min..max | box min..max | experiment |")
+    md.append("|---|---|---|---|---|---|---|---|")
     for s in surrogates:
         experiment = (MEASURED_MM["AMB"] - MEASURED_MM["LMB"] if s["response"] == PLATEAU
                       else MEASURED_MM[s["response"].split("_", 1)[1]] / MEASURED_MM["SB"])
         md.append(f"| {s['response']} | {', '.join(s['factors'])} | {s['leave_one_out_q2']:.2f} | {s['leave_one_out_rmse']:.3f} | "
-                  f"{s['observed_min']:+.3f}..{s['observed_max']:+.3f} | "
+                  + (f"{s['replica_sd']:.3f}" if s["replica_sd"] else "-") + " | "
+                  + f"{s['observed_min']:+.3f}..{s['observed_max']:+.3f} | "
                   + (f"{s['box_min']['value']:+.3f}..{s['box_max']['value']:+.3f}" if s["validated"] else
                      f"({s['box_min']['value']:+.3f}..{s['box_max']['value']:+.3f})")
                   + f" | {experiment:+.3f} |")
@@ -559,8 +613,7 @@ def analyze(study, out, permutations=2000, top=3):
     md.append("")
     md.append(f"- the run design point nearest the experiment: point {nearest['point']}, largest error {nearest['calibrated_max_error_mm']:.3f} mm ("
               + ", ".join(f"{n} {nearest[f'calibrated_error_{n}_mm']:+.3f}" for n in study["needles"] if n != "SB") + ")")
-    validated = min(joint["leave_one_out_q2"].values()) >= MIN_Q2
-    md.append(("- " if validated else f"- NOT VALIDATED (a surrogate's leave-one-out Q2 is below {MIN_Q2}: its best point is no finding): ")
+    md.append(("- " if joint["validated"] else "- NOT VALIDATED (a ratio's surrogate is not validated: its best point is no finding): ")
               + f"the surrogates' best point over {', '.join(joint['factors'])} (LOO Q2 "
               + ", ".join(f"{n} {q:.2f}" for n, q in joint["leave_one_out_q2"].items()) + f"): largest error {joint['best_max_error_mm']:.3f} mm ("
               + ", ".join(f"{n} {e:+.3f}" for n, e in joint["best_calibrated_errors_mm"].items()) + ") at "

@@ -133,6 +133,53 @@ with tempfile.TemporaryDirectory() as tmp:
     for name in ("points.csv", "hsic.csv", "hsic.md", "surrogate.json", "hsic.png", "ratio_scatter.png"):
         check(os.path.getsize(os.path.join(tmp, "analysis", name)) > 0, f"analysis/{name} is written")
 
+# Runs that scatter (a lattice's phase, rounding): the replicas' standard deviation, and a kriging that takes it as noise.
+with tempfile.TemporaryDirectory() as tmp:
+    reports = {"main.json": (-1.0, 0.10, 0.30), "r1.json": (-1.1, 0.05, 0.35), "r2.json": (-0.9, 0.20, 0.20)}
+    for name, (sb, lmb, amb) in reports.items():
+        body = {"needles": {"SB": {"status": "finished", "deflection_mm": sb}, "LMB": {"status": "finished", "deflection_mm": lmb},
+                            "AMB": {"status": "finished", "deflection_mm": amb}}}
+        if name == "main.json":
+            body["replicas"] = [{"label": "a", "results": "r1.json"}, {"label": "b", "results": "r2.json"}]
+        with open(os.path.join(tmp, name), "w") as f:
+            json.dump(body, f)
+    three = {"needles": ["SB", "LMB", "AMB"], "factors": study["factors"], "batch_points": 4, "scatter_from": "main.json"}
+    sd = gs.replica_scatter(three, tmp)
+    lmb_ratios = [lmb / sb for sb, lmb, _ in reports.values()]
+    mean = sum(lmb_ratios) / 3
+    check(abs(sd["ratio_LMB"] - (sum((r - mean) ** 2 for r in lmb_ratios) / 2) ** 0.5) < 1e-12 and abs(sd["delta_SB_mm"] - 0.1) < 1e-12,
+          f"the replicas' standard deviation of a ratio and of a deflection (ratio_LMB {sd['ratio_LMB']:.4f}, delta_SB {sd['delta_SB_mm']:.4f})")
+    try:
+        gs.replica_scatter(dict(three, scatter_from="missing.json"), tmp)
+        check(False, "a missing scatter_from is refused")
+    except gs.StudyError as e:
+        check("missing.json" in str(e), f"a missing scatter_from is refused ({e})")
+
+# A known smooth ratio plus a known noise (a fixed pseudo-random sequence, SD 0.05): with the noise given, the kriging
+# smooths it, is validated by its leave-one-out error against the noise, and finds the function's extremes; the same
+# points given a noise four times smaller than they carry are not validated.
+import random  # noqa: E402
+noise_rng = random.Random(7)
+design = {"batch_points": 48, **{k: v for k, v in study.items() if k != "batch_points"}}
+rows = []
+for point, needle_name, values in gs.batch_cases(design, 0):
+    if needle_name != "SB":
+        continue
+    row = {f["name"]: values[f["key"]] for f in design["factors"]}
+    _, ratio = truth(values)
+    row["ratio_LMB"] = ratio["LMB"] + noise_rng.gauss(0.0, 0.05)
+    rows.append(row)
+smooth = gs.kriging_surrogate(design, rows, "ratio_LMB", ["groove_start_mm", "friction"], noise_sd=0.05)
+check(smooth["validated"] and smooth["leave_one_out_rmse"] < 1.5 * 0.05,
+      f"noisy runs: the kriging given the noise is validated (LOO RMSE {smooth['leave_one_out_rmse']:.3f}, Q2 {smooth['leave_one_out_q2']:.2f})")
+check(abs(smooth["box_min"]["value"] - (-0.5)) < 0.05 and abs(smooth["box_max"]["value"] - 0.1) < 0.05,
+      f"noisy runs: the surrogate's extremes are the function's, not the noise's ({smooth['box_min']['value']:+.3f}, {smooth['box_max']['value']:+.3f} "
+      f"against -0.5, +0.1; the runs span {smooth['observed_min']:+.3f}..{smooth['observed_max']:+.3f})")
+overclaimed = gs.kriging_surrogate(design, [dict(r, ratio_LMB=r["ratio_LMB"] + noise_rng.gauss(0.0, 0.2)) for r in rows], "ratio_LMB",
+                                   ["groove_start_mm", "friction"], noise_sd=0.05)
+check(not overclaimed["validated"],
+      f"runs four times noisier than the replicas say are not validated (LOO RMSE {overclaimed['leave_one_out_rmse']:.3f}, Q2 {overclaimed['leave_one_out_q2']:.2f})")
+
 # One more parameter fitted honestly (second_parameter.py): ratios linear in the value, so every fit has a closed form.
 import second_parameter as sp  # noqa: E402
 
