@@ -36,6 +36,18 @@ struct NeedleBondCut::Grid {
 
 namespace {
 
+Eigen::Vector3d everywhere_lo() { return Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity()); }
+Eigen::Vector3d everywhere_hi() { return Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()); }
+
+void bounds_of(const std::vector<Vec3d>& x, Eigen::Vector3d& lo, Eigen::Vector3d& hi) {
+  lo = everywhere_hi();
+  hi = everywhere_lo();
+  for (const Vec3d& p : x) {
+    lo = lo.cwiseMin(Eigen::Vector3d(p));
+    hi = hi.cwiseMax(Eigen::Vector3d(p));
+  }
+}
+
 constexpr double kBarycentricTolerance = 1e-9;  // a segment through a shared edge or the seam still hits
 constexpr double kDistinctCrossing = 1e-7;      // crossings closer than this (in s) are the same point
 
@@ -66,14 +78,16 @@ double segment_triangle(const Eigen::Vector3d& a, const Eigen::Vector3d& d, doub
 
 NeedleBondCut::NeedleBondCut(const ContactSurface& surface, double candidate_margin_mm) : surface_(surface), margin_mm_(candidate_margin_mm) {}
 
-NeedleBondCut::Grid NeedleBondCut::build_grid(const Eigen::MatrixX3d& needle_x) const {
+NeedleBondCut::Grid NeedleBondCut::build_grid(const Eigen::MatrixX3d& needle_x, const Eigen::Vector3d& clip_lo, const Eigen::Vector3d& clip_hi) const {
   Grid grid;
   const Eigen::MatrixX3i& tris = surface_.triangles();
   grid.triangles.reserve(static_cast<size_t>(tris.rows()));
   const Eigen::Vector3d lo = needle_x.colwise().minCoeff(), hi = needle_x.colwise().maxCoeff();
   const double plane_tol = 1e-9 * std::max(1.0, (hi - lo).norm());
   double extent_sum = 0;
-  const auto add = [&grid](const std::array<Eigen::Vector3d, 3>& v) {
+  int primaries = 0;
+  // A triangle wholly outside the clip box (beyond the tolerance the test widens it by) meets no segment inside it.
+  const auto add = [&grid, &clip_lo, &clip_hi](const std::array<Eigen::Vector3d, 3>& v) {
     Grid::Triangle t;
     t.v0 = v[0];
     t.e1 = v[1] - v[0];
@@ -81,14 +95,18 @@ NeedleBondCut::Grid NeedleBondCut::build_grid(const Eigen::MatrixX3d& needle_x) 
     t.edge_lengths = t.e1.norm() * t.e2.norm();
     t.lo = v[0].cwiseMin(v[1]).cwiseMin(v[2]).array() - kBoxSlackMm;
     t.hi = v[0].cwiseMax(v[1]).cwiseMax(v[2]).array() + kBoxSlackMm;
+    if ((t.hi.array() < clip_lo.array()).any() || (t.lo.array() > clip_hi.array()).any()) return false;
     grid.triangles.push_back(t);
+    return true;
   };
   for (Eigen::Index t = 0; t < tris.rows(); ++t) {
     std::array<Eigen::Vector3d, 3> v;
     for (int k = 0; k < 3; ++k) v[static_cast<size_t>(k)] = needle_x.row(tris(t, k)).transpose();
-    add(v);
     const Eigen::Vector3d tlo = v[0].cwiseMin(v[1]).cwiseMin(v[2]), thi = v[0].cwiseMax(v[1]).cwiseMax(v[2]);
-    extent_sum += (thi - tlo).maxCoeff();
+    if (add(v)) {
+      extent_sum += (thi - tlo).maxCoeff();
+      ++primaries;
+    }
     // The mirror image closes a half model's surface; only triangles on the plane can meet a segment
     // that stays on the model's side (z >= 0).
     if (surface_.half_model() && tlo.z() <= plane_tol) {
@@ -97,10 +115,22 @@ NeedleBondCut::Grid NeedleBondCut::build_grid(const Eigen::MatrixX3d& needle_x) 
       add(m);
     }
   }
-  grid.cell_mm = std::max(1.5 * extent_sum / static_cast<double>(tris.rows()), 1e-3);
-  grid.lo = lo;
-  grid.hi = hi;
-  if (surface_.half_model()) grid.lo.z() = std::min(lo.z(), -hi.z());
+  if (grid.triangles.empty()) {
+    // Nothing to meet: a box that every point lies below, so every segment is passed over.
+    grid.lo.setConstant(std::numeric_limits<double>::infinity());
+    grid.hi.setConstant(-std::numeric_limits<double>::infinity());
+    grid.cells.setOnes();
+    grid.start.assign(2, 0);
+    grid.near.assign(1, 0);
+    return grid;
+  }
+  grid.cell_mm = std::max(1.5 * extent_sum / std::max(primaries, 1), 1e-3);
+  grid.lo = grid.triangles.front().lo;
+  grid.hi = grid.triangles.front().hi;
+  for (const Grid::Triangle& t : grid.triangles) {
+    grid.lo = grid.lo.cwiseMin(t.lo);
+    grid.hi = grid.hi.cwiseMax(t.hi);
+  }
   grid.lo.array() -= grid.cell_mm;
   grid.hi.array() += grid.cell_mm;
   grid.cells = ((grid.hi - grid.lo) / grid.cell_mm).array().ceil().cast<int>().cwiseMax(1);
@@ -184,7 +214,7 @@ bool NeedleBondCut::passes_through(const Grid& grid, const Eigen::Vector3d& a, c
 
 std::vector<double> NeedleBondCut::surface_crossings(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                                      const Eigen::MatrixX3d& needle_x) const {
-  return crossings(build_grid(needle_x), a, b);
+  return crossings(build_grid(needle_x, everywhere_lo(), everywhere_hi()), a, b);
 }
 
 namespace {
@@ -229,13 +259,17 @@ std::vector<std::int64_t> NeedleBondCut::scan(const Grid& grid, const IntactPair
 
 std::vector<std::int64_t> NeedleBondCut::bonds_through_needle(const BondNetwork& bonds, const std::vector<Vec3d>& x,
                                                               const Eigen::MatrixX3d& needle_x) const {
-  const Grid grid = build_grid(needle_x);
+  const Grid grid = build_grid(needle_x, everywhere_lo(), everywhere_hi());
   return scan(grid, bonds.intact.data(), static_cast<std::int64_t>(bonds.intact.size()), bonds, x);
 }
 
 std::vector<std::int64_t> NeedleBondCut::bonds_through_needle_tracked(const BondNetwork& bonds, const std::vector<Vec3d>& x,
                                                                       const Eigen::MatrixX3d& needle_x) {
-  const Grid grid = build_grid(needle_x);
+  // A bond's segment lies within the particles' box: the needle's triangles outside it (its part still in the cannula,
+  // most of it early in a run) are left out of the grid.
+  Eigen::Vector3d particles_lo, particles_hi;
+  bounds_of(x, particles_lo, particles_hi);
+  const Grid grid = build_grid(needle_x, particles_lo, particles_hi);
   if (!(margin_mm_ > 0)) return scan(grid, bonds.intact.data(), static_cast<std::int64_t>(bonds.intact.size()), bonds, x);
   // The list holds every bond the step could cut while the box lies within the listed box widened by half the margin
   // and no particle has moved half the margin along an axis: a bond left off had both ends beyond the listed box
