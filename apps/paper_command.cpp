@@ -178,7 +178,7 @@ void add_paper_command(CLI::App& app) {
       ->check(CLI::ExistingFile);
   c->add_option("--reference", o->reference, "The paper's reference table (default data/paper/reference.json)");
   add_scene_override_options(c, o->overrides);
-  c->add_option("--mesh-size-mm", o->overrides.mesh_size_mm, "Needle mesh size (run default 0.4)");
+  add_scene_flag(c, o->overrides, "--mesh-size-mm", "Needle mesh size (run default 0.4; scene key needle.mesh.size_mm)");
   c->add_option("--compare", o->compare,
                 "LABEL=FILE: set another report's results.json (another model: spacing, cut, E) beside this one in the report; "
                 "repeatable");

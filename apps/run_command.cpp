@@ -75,7 +75,7 @@ void add_run_command(CLI::App& app) {
   c->add_option("--scene", o->scene_file, "Scene file (JSON) instead of the run defaults; tissue is switched on");
   c->add_option("--out", o->run.out_dir, "Run folder to create")->required();
   add_scene_override_options(c, o->overrides);
-  c->add_option("--mesh-size-mm", o->overrides.mesh_size_mm, "Needle mesh size over the tip and groove (run default 0.4; paper 0.2)");
+  add_scene_flag(c, o->overrides, "--mesh-size-mm", "Needle mesh size over the tip and groove (run default 0.4; paper 0.2; scene key needle.mesh.size_mm)");
   c->add_option("--mass-scaling-dt-ms", o->mass_scaling_dt_ms, "Needle selective mass scaling target step (run default 5e-6; 0: off)");
   c->add_option("--tissue-E-MPa", o->tissue_E_MPa,
                 "Tissue Young's modulus (the calibrated parameter; default: the model level's SB calibration, data/paper/calibration_sb.json "

@@ -120,7 +120,7 @@ void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc) {
   t.enabled = o.boolean("enabled", t.enabled);
   t.size_mm = o.vector3("size_mm", t.size_mm);
   NEEDLE_REQUIRE((t.size_mm.array() > 0).all(), fmt::format("{} must be three positive lengths", o.where("size_mm")));
-  t.entry_x_mm = o.quantity("entry_x", Dimension::length, t.entry_x_mm, any_finite());
+  t.entry_x_mm = o.quantity("entry_x", Dimension::length, t.entry_x_mm, non_negative());
   t.offset_y_mm = o.quantity("offset_y", Dimension::length, t.offset_y_mm, any_finite());
   t.spacing_mm = o.quantity("spacing", Dimension::length, t.spacing_mm, positive());
   t.path_refinement = o.integer("path_refinement", t.path_refinement, 1, 8);
@@ -145,7 +145,13 @@ void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc) {
   t.spg.dilation = t.dilation;
   t.friction = o.number("friction", t.friction, friction_coefficient());
   t.contact.friction = t.friction;
-  if (o.has("material")) t.material = material_from_json(o.raw("material"), doc.where("/tissue/material"), t.material);
+  if (o.has("material")) {
+    t.material = material_from_json(o.raw("material"), doc.where("/tissue/material"), t.material);
+    // A relaxation time alone would be dropped from scene.json without a word (the card has no relaxation).
+    NEEDLE_REQUIRE(!o.raw("material").contains("relaxation_time_ms") || t.material.viscoelastic(),
+                   fmt::format("{}: tissue.material.relaxation_time_ms needs a relaxing_shear_fraction above 0 (the share of the shear "
+                               "stress that relaxes)", doc.where("/tissue/material/relaxation_time_ms")));
+  }
   t.material.validate();
   if (o.has("spg")) {
     SceneObject g = o.child("spg");
@@ -187,6 +193,11 @@ void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc) {
     t.separation.crack.reach_mm = c.quantity("crack_reach", Dimension::length, t.separation.crack.reach_mm, non_negative());
     t.separation.crack.angles_deg = c.numbers("crack_angles_deg", t.separation.crack.angles_deg, within(-180.0, 180.0));
     t.separation.crack.lead_mm = c.quantity("crack_lead", Dimension::length, t.separation.crack.lead_mm, non_negative());
+    // The crack's shape without a crack would be dropped from scene.json without a word.
+    NEEDLE_REQUIRE(t.separation.crack.enabled() || (t.separation.crack.angles_deg == TipCrackOptions{}.angles_deg &&
+                                                    t.separation.crack.lead_mm == TipCrackOptions{}.lead_mm),
+                   fmt::format("{}: the crack's shape (crack_angles_deg, crack_lead_mm) needs a crack: crack_reach_mm above 0",
+                               c.where(c.has("crack_angles_deg") ? "crack_angles_deg" : "crack_lead_mm")));
     // The band's depth: a length, or "whole lip" (down to the rod's bottom, however thick the lip).
     if (c.has("lip_release_depth_mm") && c.raw("lip_release_depth_mm").is_string()) {
       const std::string depth = c.raw("lip_release_depth_mm").get<std::string>();
@@ -257,6 +268,13 @@ Scene scene_from_document(const JsonDocument& doc) {
   if (root.has("output")) read_output(root.child("output"), s.output);
   root.text("description", "");
   root.finish();
+  // What one section's keys mean for another's.
+  NEEDLE_REQUIRE(!s.tissue.separation.slit.enabled() || s.needle.half_model,
+                 fmt::format("{}: tissue.contact.slit_half_height_mm: the slit opens the symmetry plane, so it needs a half model "
+                             "(needle.half_model true)", doc.where("/tissue/contact/slit_half_height_mm")));
+  NEEDLE_REQUIRE(!s.tissue.enabled || s.tissue.entry_x_mm < s.motion.travel_mm,
+                 fmt::format("{}: tissue.entry_x_mm {} mm is not less than the travel ({} mm): the tip would never reach the tissue",
+                             doc.where("/tissue/entry_x_mm"), s.tissue.entry_x_mm, s.motion.travel_mm));
   return s;
 }
 
@@ -382,21 +400,25 @@ std::string quantity_of_key(const std::string& key) {
 }  // namespace
 
 Scene apply_scene_settings(const Scene& scene, const std::vector<std::string>& settings, const std::string& source) {
+  std::vector<NamedSceneSetting> named;
+  for (const std::string& setting : settings) named.push_back({setting, source.empty() ? setting : source + " " + setting});
+  return apply_named_scene_settings(scene, named);
+}
+
+Scene apply_named_scene_settings(const Scene& scene, const std::vector<NamedSceneSetting>& settings) {
   if (settings.empty()) return scene;
-  // How a setting is named in messages: "--set key=value", or the setting alone.
-  auto named = [&](const std::string& setting) { return source.empty() ? setting : source + " " + setting; };
   json j = scene_to_json(scene);
-  std::string given;
-  for (const std::string& setting : settings) {
-    given += (given.empty() ? "" : " ") + setting;
+  std::vector<std::string> keys;
+  for (const auto& [setting, shown] : settings) {
     const size_t eq = setting.find('=');
-    NEEDLE_REQUIRE(eq != std::string::npos && eq > 0, fmt::format("{}: give key=value, e.g. {}", named(setting), named("tissue.material.E_MPa=0.1")));
+    NEEDLE_REQUIRE(eq != std::string::npos && eq > 0, fmt::format("{}: give key=value, e.g. {}", shown, "--set tissue.material.E_MPa=0.1"));
     const std::string key = setting.substr(0, eq), value = setting.substr(eq + 1);
+    keys.push_back(key);
     std::vector<std::string> path;
     for (size_t start = 0;;) {
       const size_t dot = key.find('.', start);
       path.push_back(key.substr(start, dot == std::string::npos ? std::string::npos : dot - start));
-      NEEDLE_REQUIRE(!path.back().empty(), fmt::format("{}: '{}' is not a dotted scene key (docs/scenes.md)", named(setting), key));
+      NEEDLE_REQUIRE(!path.back().empty(), fmt::format("{}: '{}' is not a dotted scene key (docs/scenes.md)", shown, key));
       if (dot == std::string::npos) break;
       start = dot + 1;
     }
@@ -404,7 +426,7 @@ Scene apply_scene_settings(const Scene& scene, const std::vector<std::string>& s
     for (size_t k = 0; k + 1 < path.size(); ++k) {
       json& next = (*section)[path[k]];
       if (next.is_null()) next = json::object();
-      NEEDLE_REQUIRE(next.is_object(), fmt::format("{}: {} is a value, not a section", named(setting), path[k]));
+      NEEDLE_REQUIRE(next.is_object(), fmt::format("{}: {} is a value, not a section", shown, path[k]));
       section = &next;
     }
     const std::string& leaf = path.back();
@@ -425,11 +447,19 @@ Scene apply_scene_settings(const Scene& scene, const std::vector<std::string>& s
     out.source = scene.source;
     return out;
   } catch (const InputError& e) {
-    // The reader names "--set:LINE: key: problem"; the line is of the generated text, so say what was set instead.
+    // The reader names "--set:LINE: key: problem"; the line is of the generated text, so say what was set instead:
+    // the settings whose key (in any unit spelling) the message names, or all of them.
     std::string message = e.what();
     const size_t colon = message.rfind("--set:", 0) == 0 ? message.find(": ") : std::string::npos;
     if (colon != std::string::npos) message = message.substr(colon + 2);
-    throw InputError(fmt::format("{}: {}", named(given), message));
+    std::string named, all;
+    for (size_t k = 0; k < settings.size(); ++k) {
+      all += (all.empty() ? "" : " ") + settings[k].shown;
+      const size_t dot = keys[k].rfind('.');
+      const std::string quantity = (dot == std::string::npos ? std::string() : keys[k].substr(0, dot + 1)) + quantity_of_key(keys[k].substr(dot + 1));
+      if (message.find(quantity) != std::string::npos) named += (named.empty() ? "" : " ") + settings[k].shown;
+    }
+    throw InputError(fmt::format("{}: {}", named.empty() ? all : named, message));
   }
 }
 

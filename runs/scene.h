@@ -114,4 +114,14 @@ nlohmann::json scene_to_json(const Scene& scene);
 // source names the settings in messages ("--set"; empty: the settings alone, as a study file's keys).
 Scene apply_scene_settings(const Scene& scene, const std::vector<std::string>& settings, const std::string& source = "--set");
 
+// One setting and how a message names it: a command's convenience flag ("--travel-mm 5") is the setting
+// motion.travel_mm=5 of its row (apps/scene_overrides.cpp), read and checked as --set is.
+struct NamedSceneSetting {
+  std::string setting;  // key=value
+  std::string shown;    // "--travel-mm 5"
+};
+// As above, the settings read together (the reader checks them as one scene); an InputError names the settings whose
+// key its message names (all of them if it names none).
+Scene apply_named_scene_settings(const Scene& scene, const std::vector<NamedSceneSetting>& settings);
+
 }  // namespace needle

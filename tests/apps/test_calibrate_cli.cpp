@@ -38,8 +38,8 @@ needle::Scene calibration_scene(double skin_mm) {
   needle::Scene scene = needle::default_run_scene();
   scene.needle.preset = "SB";
   needle::SceneOverrides overrides;
-  overrides.travel_mm = 4.0;
-  overrides.contact_skin_mm = skin_mm;
+  overrides.give("--travel-mm", {"4"});
+  overrides.give("--contact-skin-mm", {fmt::format("{}", skin_mm)});
   needle::apply_scene_overrides(scene, overrides);
   return scene;
 }

@@ -124,7 +124,7 @@ TEST_CASE("needle run --tissue-size-mm: the lattice fills the given block, and f
     CHECK(wide.internal_mJ[i] < narrow.internal_mJ[i]);
   }
 
-  refused_on_small_block("size_bad", "--tissue-size-mm 2,0,1.2", "--tissue-size-mm must be three positive lengths x,y,z (got 2,0,1.2)");
+  refused_on_small_block("size_bad", "--tissue-size-mm 2,0,1.2", "--tissue-size-mm 2,0,1.2: tissue.size_mm must be three positive lengths");
 }
 
 TEST_CASE("needle run --slit-half-height-mm: the symmetry plane opens behind the tip, and its particles leave the plane",
@@ -144,7 +144,7 @@ TEST_CASE("needle run --slit-half-height-mm: the symmetry plane opens behind the
   CHECK(open.summary["status"] == "finished");
   CHECK(open.summary["max_energy_balance_error"].get<double>() < 0.05);
 
-  refused_in_one_line("slit_bad", "--slit-half-height-mm -1", "--slit-half-height-mm must be a number >= 0 (got -1)");
+  refused_in_one_line("slit_bad", "--slit-half-height-mm -1", "--slit-half-height-mm -1: tissue.contact.slit_half_height_mm must not be negative (got -1)");
 }
 
 TEST_CASE("needle run --decel-time-ms: a ramped stop leaves the needle far less ringing than an instantaneous one", "[apps][lspg][gmsh][slow]") {
@@ -186,9 +186,9 @@ TEST_CASE("needle run --relaxing-shear-fraction: the scene says so, the relaxed 
   CHECK(gel_drag_N < 0.8 * card_drag_N);
   CHECK(gel.summary["energy_balance_error"].get<double>() < 0.02);
 
-  for (const auto& [flags, message] : {std::pair<std::string, std::string>{"--relaxing-shear-fraction 1", "relaxing_shear_fraction must lie in [0, 1)"},
-                                       {"--relaxation-time-ms 0.5", "--relaxation-time-ms needs --relaxing-shear-fraction"},
-                                       {"--relaxing-shear-fraction 0.5 --relaxation-time-ms -1", "relaxation_time_ms must be positive"}}) {
+  for (const auto& [flags, message] : {std::pair<std::string, std::string>{"--relaxing-shear-fraction 1", "--relaxing-shear-fraction 1: tissue relaxing_shear_fraction must lie in [0, 1)"},
+                                       {"--relaxation-time-ms 0.5", "--relaxation-time-ms 0.5: tissue.material.relaxation_time_ms needs a relaxing_shear_fraction above 0"},
+                                       {"--relaxing-shear-fraction 0.5 --relaxation-time-ms -1", "--relaxation-time-ms -1: tissue relaxation_time_ms must be positive"}}) {
     refused_on_small_block("relax_bad", flags, message);
   }
 }
@@ -221,7 +221,7 @@ TEST_CASE("needle run --cutting-pressure-mpa: the scene says so, the tip pays th
   }
 
   // A negative pressure, and a needle without tip facets to load (the plain rod): one line, exit 2, no run folder.
-  for (const auto& [flags, message] : {std::pair<std::string, std::string>{"--cutting-pressure-mpa -1", "--cutting-pressure-mpa must be a number >= 0"},
+  for (const auto& [flags, message] : {std::pair<std::string, std::string>{"--cutting-pressure-mpa -1", "--cutting-pressure-mpa -1: tissue.contact.cutting_pressure_MPa must not be negative"},
                                        {"--cutting-pressure-mpa 0.2", "a cutting pressure needs a needle with tip facets"}}) {
     refused_on_small_block("cutting_bad", flags, message);
   }
@@ -257,10 +257,10 @@ TEST_CASE("needle run --crack-reach-mm: the scene says so, the tip's crack cuts 
 
   // A negative reach or lead, an angle out of range, a crack's shape without a crack, and a needle without a tip point (the
   // plain rod): one line, exit 2, no run folder.
-  for (const auto& [flags, message] : {std::pair<std::string, std::string>{"--crack-reach-mm -1", "--crack-reach-mm must be a number >= 0"},
-                                       {"--crack-reach-mm 1 --crack-lead-mm -0.5", "--crack-lead-mm must be a number >= 0"},
-                                       {"--crack-lead-mm 0.5", "--crack-angles-deg and --crack-lead-mm shape the tip's crack: they need --crack-reach-mm above 0"},
-                                       {"--crack-reach-mm 1 --crack-angles-deg 0,200", "--crack-angles-deg must be angles from -180 to 180 degrees (got 0,200)"},
+  for (const auto& [flags, message] : {std::pair<std::string, std::string>{"--crack-reach-mm -1", "--crack-reach-mm -1: tissue.contact.crack_reach_mm must not be negative"},
+                                       {"--crack-reach-mm 1 --crack-lead-mm -0.5", "--crack-lead-mm -0.5: tissue.contact.crack_lead_mm must not be negative"},
+                                       {"--crack-lead-mm 0.5", "--crack-lead-mm 0.5: tissue.contact.crack_lead_mm: the crack's shape (crack_angles_deg, crack_lead_mm) needs a crack: crack_reach_mm above 0"},
+                                       {"--crack-reach-mm 1 --crack-angles-deg 0,200", "--crack-angles-deg 0,200: tissue.contact.crack_angles_deg must lie in [-180, 180] (got 200)"},
                                        {"--crack-reach-mm 1", "a crack from the tip point needs a needle with a ground tip point"}}) {
     refused_in_one_line("crack_bad", flags, message);
   }
@@ -299,8 +299,8 @@ TEST_CASE("needle run --groove-start-mm: the scene says so, the built needle's g
   CHECK(moved.summary["status"] == "finished");
 
   // A start that is not positive, a plain rod (no groove to move), and the scene key on a mesh file: one line, exit 2.
-  for (const auto& [flags, message] : {std::pair<std::string, std::string>{"--groove-start-mm 0", "--groove-start-mm must be a positive number"},
-                                       {"--groove-start-mm 4", "--groove-start-mm moves the groove of a ground tip"}}) {
+  for (const auto& [flags, message] : {std::pair<std::string, std::string>{"--groove-start-mm 0", "--groove-start-mm 0: needle.groove_start_mm must be positive"},
+                                       {"--groove-start-mm 4", "--groove-start-mm 4: needle.groove_start_mm: a groove start moves the groove of a ground tip"}}) {
     refused_in_one_line("groove_bad", flags, message);
   }
   CHECK(message_of(R"({"needle": {"plain_rod": true, "groove_start_mm": 4}})").find("a groove start moves the groove of a ground tip") !=
@@ -339,9 +339,9 @@ TEST_CASE("needle run --contact-skin-mm, --contact-stiffness-factor: the scene s
   }
 
   // A negative skin, a stiffness factor that is not positive or beyond 1e4: one line, exit 2, no run folder.
-  for (const auto& [flags, message] : {std::pair<std::string, std::string>{"--contact-skin-mm -0.01", "--contact-skin-mm must be a number >= 0"},
-                                       {"--contact-stiffness-factor 0", "--contact-stiffness-factor must be a positive number"},
-                                       {"--contact-stiffness-factor 2e4", "--contact-stiffness-factor must be at most 1e4"}}) {
+  for (const auto& [flags, message] : {std::pair<std::string, std::string>{"--contact-skin-mm -0.01", "--contact-skin-mm -0.01: tissue.contact.skin_mm must not be negative"},
+                                       {"--contact-stiffness-factor 0", "--contact-stiffness-factor 0: tissue.contact.stiffness_factor must lie in [0.001, 10000]"},
+                                       {"--contact-stiffness-factor 2e4", "--contact-stiffness-factor 2e4: tissue.contact.stiffness_factor must lie in [0.001, 10000] (got 20000)"}}) {
     refused_in_one_line("contact_bad", flags, message);
   }
 }
@@ -376,8 +376,8 @@ TEST_CASE("needle run --tissue-entry-x-mm: the block starts there, the rod meets
   for (const RunFiles* r : {&at_face, &ahead}) CHECK(r->summary["status"] == "finished");
 
   // A negative entry, or one the travel never reaches: one line, exit 2, no run folder.
-  for (const auto& [flags, message] : {std::pair<std::string, std::string>{"--tissue-entry-x-mm -0.1", "--tissue-entry-x-mm must be a number >= 0"},
-                                       {"--tissue-entry-x-mm 0.8", "--tissue-entry-x-mm must be less than the travel"}}) {
+  for (const auto& [flags, message] : {std::pair<std::string, std::string>{"--tissue-entry-x-mm -0.1", "--tissue-entry-x-mm -0.1: tissue.entry_x_mm must not be negative"},
+                                       {"--tissue-entry-x-mm 0.8", "--tissue-entry-x-mm 0.8: tissue.entry_x_mm 0.8 mm is not less than the travel"}}) {
     const std::string out = refused_on_small_block("entry_bad", flags, message);
     CHECK(std::count(out.begin(), out.end(), '\n') == 1);
   }
@@ -436,8 +436,8 @@ TEST_CASE("tissue.contact.lip_release_mode: crushed 0.45 mm deep by default, the
 
 TEST_CASE("needle run refuses an absurd friction or drive speed by its flag, as the scene key does (issue 51)", "[apps][scene]") {
   for (const auto& [flags, message] :
-       {std::pair<std::string, std::string>{"--tissue-friction 1e308", "--tissue-friction must lie in [0, 2]"},
-        {"--speed-m-per-s 1e308", "--speed-m-per-s: insertion speed 1e+308 m/s is beyond any biopsy device (at most 100 m/s)"},
+       {std::pair<std::string, std::string>{"--tissue-friction 1e308", "--tissue-friction 1e308: tissue.friction must lie in [0, 2]"},
+        {"--speed-m-per-s 1e308", "--speed-m-per-s 1e308: motion.speed_m_per_s must be positive and at most 100 m/s"},
         {"--set tissue.friction=5", "must lie in [0, 2]"},
         {"--set motion.speed_m_per_s=500", "at most 100 m/s"}}) {
     refused_in_one_line("physical_bad", flags, message);

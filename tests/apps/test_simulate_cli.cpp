@@ -363,7 +363,7 @@ TEST_CASE("Unknown flags, values that do not convert and negative counts get the
            {"run --preset SB --threads -1", "--threads: must be a whole number 0 or more (got -1)"},
            {"run --preset SB --frames 2.5", "--frames: must be a whole number 0 or more (got 2.5)"},
            {"simulate scene.json --threads -2", "--threads: must be a whole number 0 or more (got -2)"},
-           {"run --preset SB --travel-mm abc", "Could not convert: --travel-mm = abc"},
+           {"run --preset SB --travel-mm abc", "--travel-mm abc: motion.travel_mm must be a number"},
            {"tip --preset SB --bogus-flag", "--bogus-flag"}}) {
     const auto r = run(args + " --out " + (dir / "out").string(), true);
     INFO(args << ": " << r.out);
