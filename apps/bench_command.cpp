@@ -9,6 +9,7 @@
 #include "apps/cli_checks.h"
 #include "core/input_error.h"
 #include "runs/insertion_run.h"
+#include "runs/scene_request.h"
 #include "runs/json_file.h"
 #include "runs/model_levels.h"
 #include "studies/speed_error.h"
@@ -61,11 +62,12 @@ void bench_insertion(const BenchOptions& o) {
   std::vector<Case> cases;
   for (const std::string& needle : needles)
     for (const std::string& level : levels) {
-      Scene scene = base;
-      scene.tissue.enabled = true;
-      scene.needle.select_source(needle, std::nan(""), "");
-      apply_model_level(scene, level, "--levels");
-      cases.push_back({needle, level, (std::filesystem::path(o.out_dir) / fmt::format("{}_{}", needle, level)).string(), scene});
+      SceneRequest request;  // the bench scene's own E, each needle at each level (runs/scene_request.h)
+      request.scene_file = o.scene;
+      request.preset = needle;
+      request.model = level;
+      request.model_where = "--levels";
+      cases.push_back({needle, level, (std::filesystem::path(o.out_dir) / fmt::format("{}_{}", needle, level)).string(), resolve_scene(request).scene});
     }
   std::filesystem::create_directories(o.out_dir);
   std::vector<SpeedErrorCase> results;

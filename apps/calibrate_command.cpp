@@ -7,6 +7,7 @@
 
 #include "apps/cli_checks.h"
 #include "apps/scene_overrides.h"
+#include "runs/scene_request.h"
 #include "runs/insertion_run.h"
 #include "studies/calibration.h"
 
@@ -20,10 +21,14 @@ struct CalibrateOptions {
 };
 
 void calibrate(CalibrateOptions o) {
-  // Calibration starts from the run defaults' scene with the command's keys; its E is the starting point.
-  o.request.scene = default_run_scene();
-  o.request.scene.needle.preset = o.request.preset;
-  apply_scene_overrides(o.request.scene, o.overrides);
+  // Calibration starts from the run defaults' scene with the command's keys and the card's E (or --start-E-MPa): the E
+  // it finds is what the shipped calibrations hold, so it cannot start from one (runs/scene_request.h).
+  SceneRequest request;
+  request.preset = o.request.preset;
+  request.model = o.overrides.model;
+  request.card_by_default = true;
+  request.settings = scene_override_settings(o.overrides);
+  o.request.scene = resolve_scene(request).scene;
   calibrate_tissue_E(o.request);
 }
 

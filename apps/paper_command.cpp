@@ -14,6 +14,7 @@
 #include "apps/cli_checks.h"
 #include "runs/insertion_run.h"
 #include "apps/scene_overrides.h"
+#include "runs/scene_request.h"
 #include "runs/json_file.h"
 #include "studies/paper_report.h"
 #include "runs/scene.h"
@@ -59,29 +60,19 @@ std::vector<std::string> split_names(const std::string& list) {
 void paper(const PaperOptions& o) {
   const std::vector<std::string> needles = split_names(o.needles);
   const std::vector<PaperReferenceNeedle> reference = read_paper_reference(o.reference);
-  NEEDLE_REQUIRE(std::isnan(o.tissue_E_MPa) || o.calibration_file.empty(), "give --tissue-E-MPa or --calibration, not both");
-  Scene scene = default_run_scene();
-  std::string E_source = fmt::format("the default card value, {} MPa (docs/solver.md)", scene.tissue.material.E_MPa);
-  if (!o.calibration_file.empty()) {
-    scene.tissue.material.E_MPa = calibrated_E(o.calibration_file);
-    E_source = fmt::format("calibrated on SB: {}", o.calibration_file);
-  } else if (!std::isnan(o.tissue_E_MPa)) {
-    NEEDLE_REQUIRE(std::isfinite(o.tissue_E_MPa) && o.tissue_E_MPa > 0, "--tissue-E-MPa must be a positive number");
-    scene.tissue.material.E_MPa = o.tissue_E_MPa;
-    E_source = "given with --tissue-E-MPa";
-  }
-  // Without --calibration or --tissue-E-MPa, the runs take the shipped SB calibration of their model level, as
-  // `needle run` does (issue 49: the card's E 0.665 MPa put SB at -4.19 mm); --report-only reads E from the runs.
-  std::string calibration_file = o.calibration_file;
-  if (calibration_file.empty() && std::isnan(o.tissue_E_MPa) && !o.report_only) {
-    calibration_file = default_calibration_after(scene, o.overrides);
-    scene.tissue.material.E_MPa = calibrated_E(calibration_file);
-    E_source = fmt::format("calibrated on SB: {} (the shipped calibration of the model level)", calibration_file);
-  }
-  scene.tissue.material.validate();
-  const double E_before = scene.tissue.material.E_MPa;
-  apply_scene_overrides(scene, o.overrides);
-  if (scene.tissue.material.E_MPa != E_before) E_source = "given with --set";
+  // The four needles' scene: the run defaults at the given E or calibration, or the shipped SB calibration of their model
+  // level, as `needle run` takes it (issue 49: the card's E 0.665 MPa put SB at -4.19 mm); --report-only reads E from
+  // the runs. Each needle's preset is set per run below.
+  SceneRequest request;
+  request.model = o.overrides.model;
+  request.tissue_E_MPa = o.tissue_E_MPa;
+  request.calibration_file = o.calibration_file;
+  request.card_by_default = o.report_only;
+  request.settings = scene_override_settings(o.overrides);
+  const ResolvedScene resolved = resolve_scene(request);
+  Scene scene = resolved.scene;
+  std::string E_source = resolved.E_source;
+  const std::string calibration_file = resolved.calibration_file;
   std::vector<ComparedModel> compare, replicas;
   for (const auto& [texts, flag, models] : {std::tuple{&o.compare, "--compare", &compare}, std::tuple{&o.replicas, "--replica", &replicas}})
     for (const std::string& c : *texts) {

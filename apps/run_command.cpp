@@ -11,6 +11,7 @@
 #include "runs/model_levels.h"
 #include "apps/scene_overrides.h"
 #include "runs/scene.h"
+#include "runs/scene_request.h"
 #include "core/input_error.h"
 
 namespace needle {
@@ -29,38 +30,28 @@ struct RunCommandOptions {
 
 void run(const RunCommandOptions& o) {
   const int sources = !o.preset.empty() + !std::isnan(o.d_a_mm) + !o.recipe.empty();
-  NEEDLE_REQUIRE(sources <= 1, "give one of --preset, --d-a or --recipe");
   NEEDLE_REQUIRE(sources == 1 || !o.scene_file.empty(), "give a needle (--preset, --d-a or --recipe) or a --scene");
-  Scene scene = o.scene_file.empty() ? default_run_scene() : read_scene(o.scene_file);
-  scene.tissue.enabled = true;
-  if (sources == 1) scene.needle.select_source(o.preset, o.d_a_mm, o.recipe);
   // The tissue's E: given, from a calibration, from the scene file, or (the run defaults) the SB calibration shipped
-  // with the toolkit, so that the first run a user makes is the calibrated paper scene.
-  NEEDLE_REQUIRE(std::isnan(o.tissue_E_MPa) || o.calibration_file.empty(), "give --tissue-E-MPa or --calibration, not both");
-  std::string E_source = fmt::format("from the scene {}", o.scene_file);
-  if (!std::isnan(o.tissue_E_MPa)) {
-    NEEDLE_REQUIRE(std::isfinite(o.tissue_E_MPa) && o.tissue_E_MPa > 0, fmt::format("--tissue-E-MPa must be a positive number (got {})", o.tissue_E_MPa));
-    scene.tissue.material.E_MPa = o.tissue_E_MPa;
-    E_source = "given with --tissue-E-MPa";
-  } else if (!o.calibration_file.empty() || o.scene_file.empty()) {
-    const std::string file = o.calibration_file.empty() ? default_calibration_after(scene, o.overrides) : o.calibration_file;
-    scene.tissue.material.E_MPa = calibrated_E(file);
-    E_source = fmt::format("calibrated on SB: {}", file);
-  }
-  scene.tissue.material.validate();
-  NEEDLE_REQUIRE(std::isnan(o.mass_scaling_dt_ms) || (std::isfinite(o.mass_scaling_dt_ms) && o.mass_scaling_dt_ms >= 0),
-                 "--mass-scaling-dt-ms must be zero (off) or positive");
-  if (!std::isnan(o.mass_scaling_dt_ms)) scene.solver.mass_scaling_dt_ms = o.mass_scaling_dt_ms;
-  if (o.frames >= 0) scene.output.frames = o.frames;
-  if (o.no_subcycling) scene.solver.coupling.subcycling = false;
-  if (o.rigid) scene.needle.model = "rigid";
+  // with the toolkit, so that the first run a user makes is the calibrated paper scene (runs/scene_request.h).
+  SceneRequest request;
+  request.scene_file = o.scene_file;
+  request.preset = o.preset;
+  request.d_a_mm = o.d_a_mm;
+  request.recipe_file = o.recipe;
+  request.model = o.overrides.model;
+  request.tissue_E_MPa = o.tissue_E_MPa;
+  request.calibration_file = o.calibration_file;
+  if (!std::isnan(o.mass_scaling_dt_ms))
+    request.command_settings.push_back({fmt::format("solver.mass_scaling_dt_ms={}", o.mass_scaling_dt_ms), fmt::format("--mass-scaling-dt-ms {}", o.mass_scaling_dt_ms)});
+  if (o.frames >= 0) request.command_settings.push_back({fmt::format("output.frames={}", o.frames), fmt::format("--frames {}", o.frames)});
+  if (o.no_subcycling) request.command_settings.push_back({"solver.subcycling=false", "--no-subcycling"});
+  if (o.rigid) request.command_settings.push_back({"needle.model=\"rigid\"", "--rigid"});
   // The scene flags and --set come last: a --set tissue.material.E_MPa is the E the run takes.
-  const double E_before = scene.tissue.material.E_MPa;
-  apply_scene_overrides(scene, o.overrides);
-  if (scene.tissue.material.E_MPa != E_before) E_source = "given with --set";
+  request.settings = scene_override_settings(o.overrides);
+  const ResolvedScene resolved = resolve_scene(request);
   RunOptions run = o.run;
-  run.note = fmt::format("tissue E {:g} MPa, {}", scene.tissue.material.E_MPa, E_source);
-  run_insertion(scene, run);
+  run.note = fmt::format("tissue E {:g} MPa, {}", resolved.scene.tissue.material.E_MPa, resolved.E_source);
+  run_insertion(resolved.scene, run);
 }
 
 }  // namespace

@@ -115,15 +115,19 @@ void SceneOverrides::give(const std::string& flag, std::vector<std::string> valu
   given[flag] = std::move(values);
 }
 
-void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
-  if (!o.model.empty()) apply_model_level(scene, o.model);
-  std::vector<NamedSceneSetting> flags;
+std::vector<NamedSceneSetting> scene_override_settings(const SceneOverrides& o) {
+  std::vector<NamedSceneSetting> settings;
   for (const SceneFlagRow& row : scene_flag_rows()) {
     const auto it = o.given.find(row.flag);
-    if (it != o.given.end()) flags.push_back(setting_of(row, it->second));
+    if (it != o.given.end()) settings.push_back(setting_of(row, it->second));
   }
-  scene = apply_named_scene_settings(scene, flags);
-  scene = apply_scene_settings(scene, o.settings);
+  for (const std::string& setting : o.settings) settings.push_back({setting, "--set " + setting});
+  return settings;
+}
+
+void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
+  if (!o.model.empty()) apply_model_level(scene, o.model);
+  scene = apply_named_scene_settings(scene, scene_override_settings(o));
 }
 
 void add_scene_flag(CLI::App* c, SceneOverrides& o, const std::string& flag, const std::string& help) {
@@ -167,12 +171,6 @@ std::string scene_override_arguments(const SceneOverrides& o) {
     if (row.takes != SceneFlagRow::Takes::nothing) line += " " + joined(it->second);
   }
   return line;
-}
-
-std::string default_calibration_after(const Scene& scene, const SceneOverrides& overrides) {
-  Scene probe = scene;
-  apply_scene_overrides(probe, overrides);
-  return default_calibration_file(model_level_of(probe));
 }
 
 }  // namespace needle

@@ -33,12 +33,12 @@ struct SceneOverrides {
   // As if the flag were given with these values (for commands and tests that build overrides in code).
   void give(const std::string& flag, std::vector<std::string> values = {});
 };
-// The model level, then the flags' settings read together by the scene reader, then --set. An InputError names the
-// flag as given (or --set's setting) and what the reader found wrong.
+// The flags' settings then --set's, as the scene reader reads them together (runs/scene_request.h: the request's
+// settings; --model is the request's model level).
+std::vector<NamedSceneSetting> scene_override_settings(const SceneOverrides& overrides);
+// The model level, then the settings above. An InputError names the flag as given (or --set's setting) and what the
+// reader found wrong.
 void apply_scene_overrides(Scene& scene, const SceneOverrides& overrides);
-// The shipped SB calibration of the model level the scene will have once the overrides are applied (--model and
-// --set come last): the default E of `needle run` and `needle paper`.
-std::string default_calibration_after(const Scene& scene, const SceneOverrides& overrides);
 // --model, --set and every row but --mesh-size-mm, which a command adds itself where it has it (add_scene_flag).
 void add_scene_override_options(CLI::App* command, SceneOverrides& overrides);
 // One row's flag, with the command's own help text (empty: the row's).

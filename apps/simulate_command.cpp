@@ -9,6 +9,7 @@
 #include "runs/insertion_run.h"
 #include "runs/needle_alone_run.h"
 #include "runs/scene.h"
+#include "runs/scene_request.h"
 
 namespace needle {
 namespace {
@@ -21,7 +22,11 @@ struct SimulateOptions {
 
 // Everything that can be wrong with the input is found before the run folder exists.
 void run_simulation(const SimulateOptions& o) {
-  const Scene scene = apply_scene_settings(read_scene(o.scene_file), o.settings);
+  SceneRequest request;  // the scene file's own E and tissue, --set last (runs/scene_request.h)
+  request.scene_file = o.scene_file;
+  request.tissue_on = false;
+  for (const std::string& setting : o.settings) request.settings.push_back({setting, "--set " + setting});
+  const Scene scene = resolve_scene(request).scene;
   if (scene.tissue.enabled) run_insertion(scene, o.run);
   else run_needle_alone(scene, o.run);
 }

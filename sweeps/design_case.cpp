@@ -10,6 +10,7 @@
 #include "geometry/tip_geometry.h"
 #include "runs/csv_table.h"
 #include "runs/insertion_run.h"
+#include "runs/scene_request.h"
 #include "runs/json_file.h"
 #include "runs/model_levels.h"
 #include "runs/recipe_json.h"
@@ -128,21 +129,30 @@ void check_variable_name(const std::string& name, const std::string& where) {
 }
 
 CaseSetup case_setup(const DesignBase& b, const json& values) {
-  Scene scene = b.scene_file.empty() ? default_run_scene() : read_scene(b.scene_file);
-  scene.tissue.enabled = true;
-  if (!b.preset.empty() || !b.recipe_file.empty() || std::isfinite(b.d_a_mm)) scene.needle.select_source(b.preset, b.d_a_mm, b.recipe_file);
-  if (!b.model.empty()) apply_model_level(scene, b.model, "model");
-  if (!b.calibration_file.empty() || b.scene_file.empty())
-    scene.tissue.material.E_MPa = calibrated_E(b.calibration_file.empty() ? default_calibration_file(model_level_of(scene)) : b.calibration_file);
-  std::vector<std::string> settings;
-  for (const auto& item : b.settings.items()) settings.push_back(item.key() + "=" + setting_text(item.value()));
+  // The case's scene as `needle run` resolves it (runs/scene_request.h): the study's base, then its "set" keys and the
+  // case's variables, read together last; the tissue's E from the base's calibration, or the shipped one of the model
+  // level the case's scene has.
+  SceneRequest request;
+  request.scene_file = b.scene_file;
+  request.preset = b.preset;
+  request.d_a_mm = std::isfinite(b.d_a_mm) ? b.d_a_mm : std::nan("");
+  request.recipe_file = b.recipe_file;
+  request.model = b.model;
+  request.model_where = "model";
+  request.calibration_file = b.calibration_file;
+  std::vector<NamedSceneSetting> settings;
+  for (const auto& item : b.settings.items()) {
+    const std::string setting = item.key() + "=" + setting_text(item.value());
+    settings.push_back({setting, setting});  // the keys are the study file's variables and "set", not --set flags
+  }
   MultiBevelAngles angles;
   bool angles_given = false;
   double d_a = std::nan("");
   for (const auto& item : values.items()) {
     const std::string& name = item.key();
     if (!is_tip_variable(name)) {
-      settings.push_back(name + "=" + setting_text(item.value()));
+      const std::string setting = name + "=" + setting_text(item.value());
+      settings.push_back({setting, setting});
       continue;
     }
     NEEDLE_REQUIRE(item.value().is_number(), fmt::format("{} must be a number (got {})", name, item.value().dump()));
@@ -153,8 +163,9 @@ CaseSetup case_setup(const DesignBase& b, const json& values) {
     if (name == "side_rotation_deg") angles.side_rotation_deg = x;
     angles_given = angles_given || name != "d_a_mm";
   }
+  request.settings = settings;
   CaseSetup setup;
-  setup.scene = apply_scene_settings(scene, settings, "");  // the keys are the study file's variables and "set", not --set flags
+  setup.scene = resolve_scene(request).scene;
   NeedleScene& needle = setup.scene.needle;
   if (angles_given) {
     Rod rod;
