@@ -30,7 +30,7 @@ struct RunCommandOptions {
 
 void run(const RunCommandOptions& o) {
   const int sources = !o.preset.empty() + !std::isnan(o.d_a_mm) + !o.recipe.empty();
-  NEEDLE_REQUIRE(sources == 1 || !o.scene_file.empty(), "give a needle (--preset, --d-a or --recipe) or a --scene");
+  NEEDLE_REQUIRE(sources >= 1 || !o.scene_file.empty(), "give a needle (--preset, --d-a or --recipe) or a --scene");
   // The tissue's E: given, from a calibration, from the scene file, or (the run defaults) the SB calibration shipped
   // with the toolkit, so that the first run a user makes is the calibrated paper scene (runs/scene_request.h).
   SceneRequest request;

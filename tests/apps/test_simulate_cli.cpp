@@ -364,6 +364,7 @@ TEST_CASE("Unknown flags, values that do not convert and negative counts get the
            {"run --preset SB --frames 2.5", "--frames: must be a whole number 0 or more (got 2.5)"},
            {"simulate scene.json --threads -2", "--threads: must be a whole number 0 or more (got -2)"},
            {"run --preset SB --travel-mm abc", "--travel-mm abc: motion.travel_mm must be a number"},
+           {"run --preset SB --d-a 0.1", "give one of --preset, --d-a or --recipe"},
            {"tip --preset SB --bogus-flag", "--bogus-flag"}}) {
     const auto r = run(args + " --out " + (dir / "out").string(), true);
     INFO(args << ": " << r.out);
