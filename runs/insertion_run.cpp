@@ -1,11 +1,11 @@
 #include "runs/insertion_run.h"
 
-#include <algorithm>
 #include <chrono>
 #include <fmt/format.h>
 #include <fstream>
 
-#include "runs/json_file.h"
+#include "runs/insertion_measures.h"
+#include "runs/insertion_output.h"
 #include "runs/model_levels.h"
 #include "runs/run_driver.h"
 #include "runs/run_folder.h"
@@ -13,226 +13,15 @@
 #include "runs/scene_particles.h"
 #include "core/input_error.h"
 #include "mesher/particle_lattice.h"
-#include "mesher/vtk_files.h"
-#include "solver/insertion/groove_fill.h"
-#include "solver/insertion/strain_probes.h"
 #include "solver/insertion/coupled_insertion.h"
 #include "solver/needle/needle_models.h"
 #include "solver/separation/separation_models.h"
-#include "core/parallel.h"
-#include "core/solver_error.h"
-
-#ifndef NEEDLE_DATA_DIR
-#define NEEDLE_DATA_DIR "data"
-#endif
 
 namespace needle {
 namespace {
 
 using nlohmann::json;
 using Clock = std::chrono::steady_clock;
-
-// Broken bonds per particle.
-Eigen::VectorXd broken_bonds(const SpgTissue& tissue) {
-  Eigen::VectorXd count = Eigen::VectorXd::Zero(tissue.particles().size());
-  for (const Bond& b : tissue.bonds().bonds)
-    if (b.broken) {
-      count[b.i] += 1;
-      count[b.j] += 1;
-    }
-  return count;
-}
-
-// The particles pulled back into the needle's reference frame (as the contact does), and the tissue block's x range there.
-struct PulledBackTissue {
-  std::vector<Eigen::Vector3d> points;
-  double min_x_mm = 0, max_x_mm = 0;
-};
-
-PulledBackTissue pulled_back_tissue(CoupledInsertion& run, const Scene& scene) {
-  const double drive_x = run.needle().drive_displacement_mm().x();
-  return {run.contact_model().pull_back(run.tissue().particles().position_mm, run.needle().positions_mm()),
-          scene.tissue.entry_x_mm - drive_x, scene.tissue.entry_x_mm + scene.tissue.size_mm.x() - drive_x};
-}
-
-// The groove fill of the run's current state (groove_fill.h); empty without a groove.
-GrooveFill run_groove_fill(CoupledInsertion& run, const SceneNeedle& needle, const Scene& scene) {
-  if (!needle.groove) return {};
-  const TissueParticles& p = run.tissue().particles();
-  NeedleTissueContact& contact = run.contact_model();
-  PulledBackTissue tissue = pulled_back_tissue(run, scene);
-  GrooveFillInput in;
-  in.groove = *needle.groove;
-  in.radius_mm = needle.radius_mm;
-  in.tissue_min_x_mm = tissue.min_x_mm;
-  in.tissue_max_x_mm = tissue.max_x_mm;
-  in.reference_points = std::move(tissue.points);
-  in.spacing_mm = p.spacing_mm;
-  in.touches_floor.assign(in.reference_points.size(), 0);
-  const ContactSurface& surface = contact.surface();
-  for (const auto& [particle, triangle] : contact.contacts())
-    if (triangle >= 0 && surface.tag_names()[static_cast<size_t>(surface.triangle_tag(triangle))] == "groove_floor")
-      in.touches_floor[static_cast<size_t>(particle)] = 1;
-  return measure_groove_fill(in);
-}
-
-// The tissue's minimum principal strain where the paper's model shows it (strain_probes.h), at the run's current state.
-StrainProbes run_strain_probes(CoupledInsertion& run, const SceneNeedle& needle, const Scene& scene) {
-  const TissueParticles& p = run.tissue().particles();
-  NeedleTissueContact& contact = run.contact_model();
-  PulledBackTissue tissue = pulled_back_tissue(run, scene);
-  StrainProbeInput in;
-  in.reference_points = std::move(tissue.points);
-  in.tissue_min_x_mm = tissue.min_x_mm;
-  in.tissue_max_x_mm = tissue.max_x_mm;
-  in.spacing_mm = p.spacing_mm;
-  in.min_principal_strain.resize(p.elastic_left_cauchy_green.size());
-  for (size_t i = 0; i < in.min_principal_strain.size(); ++i) in.min_principal_strain[i] = min_principal_log_strain(p.elastic_left_cauchy_green[i]);
-  const ContactSurface& surface = contact.surface();
-  in.contact_tag.assign(in.reference_points.size(), -1);
-  for (const auto& [particle, triangle] : contact.contacts())
-    if (triangle >= 0) in.contact_tag[static_cast<size_t>(particle)] = surface.triangle_tag(triangle);
-  in.tag_names = surface.tag_names();
-  in.tip_point = needle.tip_point;
-  in.groove = needle.groove;
-  in.radius_mm = needle.radius_mm;
-  return probe_strains(in);
-}
-
-json strain_probes_json(const StrainProbes& probes, double insertion_mm, double deflection_mm) {
-  auto region = [](const StrainRegion& r) {
-    auto number = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
-    return json{{"particles", r.particles}, {"median", number(r.median)}, {"p05", number(r.p05)}, {"min", number(r.min)}};
-  };
-  return {{"insertion_mm", insertion_mm},
-          {"deflection_mm", deflection_mm},
-          {"tip_top", region(probes.tip_top)},
-          {"below_tip", region(probes.below_tip)},
-          {"groove", region(probes.groove)}};
-}
-
-class InsertionOutput {
- public:
-  InsertionOutput(const RunFolder& folder, const ContactSurface& surface, const std::vector<std::unique_ptr<SeparationModel>>& separations)
-      : folder_(folder), surface_(surface) {
-    history_.open(folder.path("history.csv"));
-    history_ << "time_ms,insertion_mm,tip_dx_mm,tip_dy_mm,tip_dz_mm,deflection_mm,drive_force_x_N,drive_force_y_N,drive_force_z_N,"
-                "contact_force_x_N,contact_force_y_N,contact_force_z_N,particles_in_contact,particles_inside,max_depth_mm,"
-                "bonds_broken,tissue_kinetic_mJ,tissue_internal_mJ,needle_kinetic_mJ,needle_strain_mJ,drive_work_mJ,"
-                "cannula_work_mJ,contact_work_mJ,penalty_energy_mJ,friction_dissipation_mJ,relinearisation_energy_mJ,energy_balance_error,"
-                "coupling_step_ms,needle_steps,groove_fill,groove_floor_contact_fraction";
-    for (const auto& separation : separations)
-      for (const std::string& column : separation->history_columns()) history_ << "," << column;
-    history_ << "\n";
-    facets_.open(folder.path("facet_forces.csv"));
-    facets_ << "time_ms,insertion_mm";
-    for (const std::string& tag : surface.tag_names())
-      if (tag != "symmetry")
-        facets_ << fmt::format(",{0}_particles,{0}_normal_N,{0}_friction_N,{0}_fx_N,{0}_fy_N,{0}_fz_N", tag);
-    facets_ << "\n";
-  }
-
-  void record(const CoupledInsertion& run, int tip, const GrooveFill& groove) {
-    const NeedleModel& n = run.needle();
-    const Eigen::RowVector3d u = n.positions_mm().row(tip) - n.mesh().X.row(tip);
-    const Eigen::Vector3d drive = n.drive_displacement_mm(), reaction = n.drive_reaction_N();
-    const ContactReport& c = run.contact();
-    const InsertionEnergy& e = run.energy();
-    history_ << fmt::format(
-        "{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{},{},{:.6g},{},{:.9g},{:.9g},{:.9g},{:.9g},"
-        "{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.6g},{:.6g},{},{:.4f},{:.4f}",
-        run.time_ms(), drive.norm(), u.x(), u.y(), u.z(), u.y() - drive.y(), reaction.x(), reaction.y(), reaction.z(),
-        c.force_on_needle_N.x(), c.force_on_needle_N.y(), c.force_on_needle_N.z(), c.particles_in_contact, c.particles_inside,
-        c.max_depth_mm, run.bonds_broken(), e.tissue_kinetic_mJ, e.tissue_internal_mJ, e.needle_kinetic_mJ, e.needle_strain_mJ,
-        e.drive_work_mJ, e.cannula_work_mJ, e.contact_work_mJ, e.penalty_energy_mJ, e.friction_dissipation_mJ, e.relinearisation_energy_mJ, e.balance_error(),
-        run.last_step_ms(), run.needle_steps(), groove.groove_fill, groove.floor_contact_fraction);
-    for (const auto& separation : run.separations())
-      for (const std::string& value : separation->history_values()) history_ << "," << value;
-    history_ << "\n";
-    facets_ << fmt::format("{:.9g},{:.9g}", run.time_ms(), drive.norm());
-    for (size_t k = 0; k < surface_.tag_names().size(); ++k) {
-      if (surface_.tag_names()[k] == "symmetry") continue;
-      const FacetContact& f = c.facets[k];
-      facets_ << fmt::format(",{},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}", f.particles, f.normal_N, f.friction_N, f.force_N.x(), f.force_N.y(),
-                             f.force_N.z());
-    }
-    facets_ << "\n";
-    history_.flush();  // a run killed from outside still leaves its history
-    facets_.flush();
-  }
-
-  void frame(const CoupledInsertion& run) {
-    const int index = static_cast<int>(needle_frames_.size());
-    const std::string needle_name = fmt::format("frames/needle_{:04}.vtu", index);
-    write_needle_vtu(folder_.path(needle_name).string(), run.needle());
-    needle_frames_.emplace_back(run.time_ms(), needle_name);
-
-    const TissueParticles& p = run.tissue().particles();
-    const Eigen::Index np = p.size();
-    Eigen::MatrixX3d x(np, 3), u(np, 3), v(np, 3);
-    Eigen::VectorXd plastic(np), effective(np), min_principal(np), mises(np), contact(np);
-    const std::vector<std::uint8_t> in_contact = run.contact_model().in_contact();
-    for (Eigen::Index i = 0; i < np; ++i) {
-      const size_t s = static_cast<size_t>(i);
-      x.row(i) = p.position_mm[s].transpose();
-      u.row(i) = (p.position_mm[s] - p.initial_mm[s]).transpose();
-      v.row(i) = p.velocity_mm_per_ms[s].transpose();
-      plastic[i] = p.plastic_strain[s];
-      effective[i] = p.effective_strain[s];
-      min_principal[i] = min_principal_log_strain(p.elastic_left_cauchy_green[s]);
-      const Mat3d dev = p.stress_MPa[s] - p.stress_MPa[s].trace() / 3 * Mat3d::Identity();
-      mises[i] = std::sqrt(1.5 * dev.squaredNorm());
-      contact[i] = in_contact[s];
-    }
-    const std::string tissue_name = fmt::format("frames/tissue_{:04}.vtp", index);
-    write_vtp(folder_.path(tissue_name).string(), x,
-              {{"displacement_mm", u}, {"velocity_m_per_s", v}, {"plastic_strain", plastic}, {"effective_strain", effective},
-               {"min_principal_strain", min_principal}, {"von_mises_MPa", mises},
-               {"broken_bonds", broken_bonds(run.tissue())}, {"in_contact", contact}},
-              VtkEncoding::binary);
-    tissue_frames_.emplace_back(run.time_ms(), tissue_name);
-  }
-
-  void finish() {
-    history_.close();
-    facets_.close();
-    write_pvd(folder_.path("needle.pvd"), needle_frames_);
-    write_pvd(folder_.path("tissue.pvd"), tissue_frames_);
-  }
-
- private:
-  const RunFolder& folder_;
-  const ContactSurface& surface_;
-  std::ofstream history_, facets_;
-  std::vector<std::pair<double, std::string>> needle_frames_, tissue_frames_;
-};
-
-}  // namespace
-
-std::string default_calibration_file(const std::string& model_level) {
-  // A level's own calibration; a custom combination takes the default (fast) level's.
-  const ModelLevel* level = find_model_level(model_level);
-  return std::string(NEEDLE_DATA_DIR) + "/paper/" + (level ? level->calibration_file : find_model_level(kDefaultModelLevel)->calibration_file);
-}
-
-double calibrated_E(const std::string& path) {
-  const json j = read_json_file(path, "calibration");
-  NEEDLE_REQUIRE(j.contains("tissue_E_MPa") && j["tissue_E_MPa"].is_number() && j["tissue_E_MPa"].get<double>() > 0,
-                 fmt::format("{}: tissue_E_MPa must be a positive number", path));
-  return j["tissue_E_MPa"].get<double>();
-}
-
-Scene default_run_scene() {
-  Scene s = parse_scene("{}", "(needle run defaults)");
-  s.tissue.enabled = true;
-  s.needle.mesh.size_mm = 0.4;
-  s.solver.mass_scaling_dt_ms = 5e-6;
-  s.tissue.path_refinement = 2;  // 0.2 mm particles within 1.2 mm of the path: the tip's bevels see tissue
-  apply_model_level(s, kDefaultModelLevel, "the run defaults");
-  return s;
-}
-
-namespace {
 
 // The coupled insertion of a scene as the run driver runs it (run_driver.h).
 class InsertionRunModel : public RunModel {

@@ -3,7 +3,7 @@
 #include <fmt/format.h>
 
 #include "core/input_error.h"
-#include "runs/insertion_run.h"
+#include "runs/run_defaults.h"
 #include "runs/model_levels.h"
 
 namespace needle {

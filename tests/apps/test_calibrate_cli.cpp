@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "runs/insertion_run.h"
+#include "runs/run_defaults.h"
 #include "apps/scene_overrides.h"
 #include "runs/scene.h"
 #include "cli_run.h"

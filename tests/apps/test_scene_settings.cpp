@@ -8,6 +8,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
+#include "runs/run_defaults.h"
 #include "runs/scene.h"
 #include "cli_run.h"
 #include "core/input_error.h"

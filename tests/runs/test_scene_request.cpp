@@ -8,6 +8,7 @@
 
 #include "core/input_error.h"
 #include "runs/insertion_run.h"
+#include "runs/run_defaults.h"
 #include "runs/model_levels.h"
 #include "runs/scene_request.h"
 
