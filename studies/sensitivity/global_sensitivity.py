@@ -399,7 +399,18 @@ def pce_sobol(study, rows, response, degree=2):
     result = fit(x, y)
     sobol = ot.FunctionalChaosSobolIndices(result)
     indices = {f["name"]: (float(sobol.getSobolIndex(j)), float(sobol.getSobolTotalIndex(j))) for j, f in enumerate(factors)}
-    return {"response": response, "degree": degree, "terms": int(result.getIndices().getSize()), "leave_one_out_q2": q2, "sobol": indices}
+    # The chaos's lowest and highest value over the whole box (every factor over its range or levels): where its Q2
+    # validates it, how far the box can move the response.
+    grid = box_grid(factors)
+    values = result.getMetaModel()(grid)
+    k_min = min(range(grid.getSize()), key=lambda i: values[i][0])
+    k_max = max(range(grid.getSize()), key=lambda i: values[i][0])
+
+    def at(k):
+        return {f["name"]: value_at_unit(f, float(grid[k, j])) for j, f in enumerate(factors)}
+
+    return {"response": response, "degree": degree, "terms": int(result.getIndices().getSize()), "leave_one_out_q2": q2, "sobol": indices,
+            "validated": q2 >= MIN_Q2, "box_min": {"value": values[k_min][0], "at": at(k_min)}, "box_max": {"value": values[k_max][0], "at": at(k_max)}}
 
 
 def chaos_or_none(study, rows, response):
@@ -607,7 +618,10 @@ def analyze(study, out, permutations=2000, top=3, root=None):
     for c in chaos:
         big = sorted(((n, v) for n, v in c["sobol"].items() if v[1] >= 0.05), key=lambda kv: -kv[1][1])
         md.append(f"- {c['response']} (degree {c['degree']}, Q2 {c['leave_one_out_q2']:.2f}, {c['terms']} terms): "
-                  + (", ".join(f"{n} {v[0]:.2f} / {v[1]:.2f}" for n, v in big) if big else "no factor reaches 0.05"))
+                  + (", ".join(f"{n} {v[0]:.2f} / {v[1]:.2f}" for n, v in big) if big else "no factor reaches 0.05")
+                  + (f"; over the whole box {c['box_min']['value']:+.3f}..{c['box_max']['value']:+.3f} (lowest at "
+                     + ", ".join(f"{k} {v:.4g}" if isinstance(v, float) else f"{k} {v}" for k, v in c["box_min"]["at"].items()) + ")"
+                     if c["validated"] else ""))
     md.append("")
     md.append("Calibrated on SB to first order (each needle's deflection = the measured SB's x its ratio to SB), against the experiment:")
     md.append("")

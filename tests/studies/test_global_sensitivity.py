@@ -119,6 +119,9 @@ with tempfile.TemporaryDirectory() as tmp:
     check(abs(chaos["sobol"]["groove_start_mm"][0] - var_g / (var_g + var_f)) < 0.05 and abs(chaos["sobol"]["friction"][1] - var_f / (var_g + var_f)) < 0.05,
           f"its Sobol' indices are the closed form's (groove {chaos['sobol']['groove_start_mm'][0]:.3f} against {var_g / (var_g + var_f):.3f}, "
           f"friction {chaos['sobol']['friction'][1]:.3f} against {var_f / (var_g + var_f):.3f})")
+    check(chaos["validated"] and abs(chaos["box_min"]["value"] - (-1.3)) < 0.03 and abs(chaos["box_max"]["value"] - 0.0) < 0.03,
+          f"the chaos of AMB's ratio reaches the function's extremes over the whole box ({chaos['box_min']['value']:.3f}, "
+          f"{chaos['box_max']['value']:.3f} against -1.3, 0.0)")
     # The joint search's best point against the function's own minimax, by brute force over its two drivers.
     best = float("inf")
     for i in range(201):
