@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 
 #include "core/input_error.h"
-#include "runs/insertion_run.h"
 #include "runs/model_levels.h"
 #include "solver/contact/needle_tissue_contact.h"
 
@@ -123,11 +122,6 @@ std::vector<NamedSceneSetting> scene_override_settings(const SceneOverrides& o) 
   }
   for (const std::string& setting : o.settings) settings.push_back({setting, "--set " + setting});
   return settings;
-}
-
-void apply_scene_overrides(Scene& scene, const SceneOverrides& o) {
-  if (!o.model.empty()) apply_model_level(scene, o.model);
-  scene = apply_named_scene_settings(scene, scene_override_settings(o));
 }
 
 void add_scene_flag(CLI::App* c, SceneOverrides& o, const std::string& flag, const std::string& help) {

@@ -34,11 +34,9 @@ struct SceneOverrides {
   void give(const std::string& flag, std::vector<std::string> values = {});
 };
 // The flags' settings then --set's, as the scene reader reads them together (runs/scene_request.h: the request's
-// settings; --model is the request's model level).
+// settings; --model is the request's model level). An InputError names the flag as given (or --set's setting) and what
+// the reader found wrong.
 std::vector<NamedSceneSetting> scene_override_settings(const SceneOverrides& overrides);
-// The model level, then the settings above. An InputError names the flag as given (or --set's setting) and what the
-// reader found wrong.
-void apply_scene_overrides(Scene& scene, const SceneOverrides& overrides);
 // --model, --set and every row but --mesh-size-mm, which a command adds itself where it has it (add_scene_flag).
 void add_scene_override_options(CLI::App* command, SceneOverrides& overrides);
 // One row's flag, with the command's own help text (empty: the row's).

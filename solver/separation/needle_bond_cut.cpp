@@ -39,15 +39,6 @@ namespace {
 Eigen::Vector3d everywhere_lo() { return Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity()); }
 Eigen::Vector3d everywhere_hi() { return Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()); }
 
-void bounds_of(const std::vector<Vec3d>& x, Eigen::Vector3d& lo, Eigen::Vector3d& hi) {
-  lo = everywhere_hi();
-  hi = everywhere_lo();
-  for (const Vec3d& p : x) {
-    lo = lo.cwiseMin(Eigen::Vector3d(p));
-    hi = hi.cwiseMax(Eigen::Vector3d(p));
-  }
-}
-
 constexpr double kBarycentricTolerance = 1e-9;  // a segment through a shared edge or the seam still hits
 constexpr double kDistinctCrossing = 1e-7;      // crossings closer than this (in s) are the same point
 
@@ -265,19 +256,24 @@ std::vector<std::int64_t> NeedleBondCut::bonds_through_needle(const BondNetwork&
 
 std::vector<std::int64_t> NeedleBondCut::bonds_through_needle_tracked(const BondNetwork& bonds, const std::vector<Vec3d>& x,
                                                                       const Eigen::MatrixX3d& needle_x) {
-  // A bond's segment lies within the particles' box: the needle's triangles outside it (its part still in the cannula,
-  // most of it early in a run) are left out of the grid.
-  Eigen::Vector3d particles_lo, particles_hi;
-  bounds_of(x, particles_lo, particles_hi);
+  // One pass over the particles: their box (a bond's segment lies within it, so the needle's triangles outside it, its
+  // part still in the cannula early in a run, are left out of the grid) and whether one has moved half the margin
+  // along an axis since the list was made.
+  const double half = 0.5 * margin_mm_;
+  const bool compare = margin_mm_ > 0 && listed_ && listed_x_.size() == x.size();
+  bool still = compare;
+  Eigen::Vector3d particles_lo = everywhere_hi(), particles_hi = everywhere_lo();
+  for (size_t i = 0; i < x.size(); ++i) {
+    particles_lo = particles_lo.cwiseMin(x[i]);
+    particles_hi = particles_hi.cwiseMax(x[i]);
+    if (still) still = (x[i] - listed_x_[i]).cwiseAbs().maxCoeff() < half;
+  }
   const Grid grid = build_grid(needle_x, particles_lo, particles_hi);
   if (!(margin_mm_ > 0)) return scan(grid, bonds.intact.data(), static_cast<std::int64_t>(bonds.intact.size()), bonds, x);
   // The list holds every bond the step could cut while the box lies within the listed box widened by half the margin
   // and no particle has moved half the margin along an axis: a bond left off had both ends beyond the listed box
   // widened by the whole margin, on one side, and so both still lie beyond the current box on that side.
-  const double half = 0.5 * margin_mm_;
-  bool valid = listed_ && listed_x_.size() == x.size() && (grid.lo.array() >= list_lo_.array() + half).all() &&
-               (grid.hi.array() <= list_hi_.array() - half).all();
-  for (size_t i = 0; valid && i < x.size(); ++i) valid = (x[i] - listed_x_[i]).cwiseAbs().maxCoeff() < half;
+  const bool valid = still && (grid.lo.array() >= list_lo_.array() + half).all() && (grid.hi.array() <= list_hi_.array() - half).all();
   if (!valid) {
     list_lo_ = grid.lo.array() - margin_mm_;
     list_hi_ = grid.hi.array() + margin_mm_;

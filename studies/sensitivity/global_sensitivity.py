@@ -23,6 +23,7 @@ import csv
 import json
 import math
 import os
+import statistics
 import subprocess
 import sys
 
@@ -305,11 +306,7 @@ def replica_scatter(study, root):
             samples.setdefault(k, []).append(v)
     if not samples or min(len(v) for v in samples.values()) < 2:
         raise StudyError(f"scatter_from {study['scatter_from']}: fewer than two reports with every needle of the study")
-    out = {}
-    for k, v in samples.items():
-        mean = sum(v) / len(v)
-        out[k] = math.sqrt(sum((x - mean) ** 2 for x in v) / (len(v) - 1))
-    return out
+    return {k: statistics.stdev(v) for k, v in samples.items()}
 
 
 def surrogate_validated(q2, rmse, scatter_sd):

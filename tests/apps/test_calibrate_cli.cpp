@@ -9,6 +9,7 @@
 
 #include "runs/insertion_run.h"
 #include "runs/run_defaults.h"
+#include "runs/scene_request.h"
 #include "apps/scene_overrides.h"
 #include "runs/scene.h"
 #include "cli_run.h"
@@ -36,13 +37,14 @@ void write_run_at(const fs::path& runs, const needle::Scene& base, double E_MPa,
 needle::Scene calibration_scene(double skin_mm) {
   // What `calibrate --preset SB --travel-mm 4 --contact-skin-mm <skin>` runs (the short travel keeps a run cheap
   // should the test ever make one).
-  needle::Scene scene = needle::default_run_scene();
-  scene.needle.preset = "SB";
   needle::SceneOverrides overrides;
   overrides.give("--travel-mm", {"4"});
   overrides.give("--contact-skin-mm", {fmt::format("{}", skin_mm)});
-  needle::apply_scene_overrides(scene, overrides);
-  return scene;
+  needle::SceneRequest request;  // as calibrate_command.cpp asks for it
+  request.preset = "SB";
+  request.card_by_default = true;
+  request.settings = needle::scene_override_settings(overrides);
+  return needle::resolve_scene(request).scene;
 }
 
 }  // namespace
