@@ -1,6 +1,8 @@
 #include "runs/model_levels.h"
 
 #include <fmt/format.h>
+#include <string>
+#include <vector>
 
 #include "core/input_error.h"
 #include "solver/contact/contact_laws.h"
@@ -52,6 +54,31 @@ std::string model_level_of(const Scene& scene) {
         scene.tissue.spg.support == level.support)
       return level.name;
   return "custom";
+}
+
+std::string describe_model_choices(const Scene& scene) {
+  const ModelLevel& full = *find_model_level(kReferenceModelLevel);
+  const std::string& needle_name = scene.needle.model;
+  const std::string& law = scene.tissue.contact.law;
+  const NeedleModelEntry& needle_entry = needle_model(needle_name);
+  const bool mass_scaled = scene.solver.tissue_mass_scaling || scene.solver.tissue_mass_scaling_dt_ms > 0;
+  const bool ellipsoids = scene.tissue.spg.support == SupportShape::ellipsoid;
+  const int rate_levels = scene.solver.coupling.tissue_rate_levels;
+  const std::string multirate =
+      rate_levels > 0 ? fmt::format("the tissue away from the needle stepped at up to {} coupling steps (multi-rate)", 1 << rate_levels) : "";
+  std::vector<std::string> choices;
+  if (mass_scaled) choices.emplace_back("the tissue selectively mass-scaled");
+  if (ellipsoids) choices.emplace_back("ellipsoidal kernel supports");
+  if (!multirate.empty()) choices.push_back(multirate);
+  std::string listed;
+  for (const std::string& c : choices) listed += (listed.empty() ? "" : ", ") + c;
+  if (law == full.contact_law && !needle_entry.takes_coupling_step) return listed;
+  std::string level_flag;  // the level these keys make, if any but the full one
+  for (const ModelLevel& level : model_levels())
+    if (level.name != full.name && level.needle_model == needle_name && level.contact_law == law && level.tissue_mass_scaling == mass_scaled &&
+        (level.support == SupportShape::ellipsoid) == ellipsoids && level.tissue_rate_levels == rate_levels)
+      level_flag = fmt::format(" (--model {})", level.name);
+  return fmt::format("{} and {}{}{}", needle_entry.phrase, contact_law(law).phrase, listed.empty() ? "" : ", " + listed, level_flag);
 }
 
 void check_model_combination(const Scene& scene) {

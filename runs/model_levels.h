@@ -38,5 +38,10 @@ std::string model_level_of(const Scene& scene);
 const ModelLevel* find_model_level(const std::string& name);
 // InputError for a combination no level allows: the implicit needle with the penalty contact.
 void check_model_combination(const Scene& scene);
+// The needle model, the contact law and the tissue's speed choices (mass scaling, ellipsoidal supports, multi-rate) in
+// a run's one-line description (the paper report), in their registries' words, with the level they make. The full
+// level's needle and contact go unnamed, and so does a needle that does not take the coupling step with that contact
+// (the rigid one, which the report says elsewhere); empty when nothing is said.
+std::string describe_model_choices(const Scene& scene);
 
 }  // namespace needle

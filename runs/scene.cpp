@@ -72,13 +72,15 @@ void read_needle(SceneObject o, NeedleScene& n, const std::string& scene_folder)
     n.material.density_g_per_mm3 = m.quantity("density", Dimension::density, n.material.density_g_per_mm3, positive());
     m.finish();
   }
-  // needle.model names a registered needle model (solver/needle/needle_models.h); rigid: true is the older
-  // way to say model "rigid", and the effective scene still says it so that stored scenes read the same.
+  // needle.model names a registered needle model (solver/needle/needle_models.h); a model's legacy key (rigid: true) is
+  // the older way to select it, and contradicts any other model named beside it but the default.
   n.model = o.text("model", n.model);
   needle_model(n.model, o.where("model"));  // refuses an unknown name with the file and line
-  if (o.boolean("rigid", n.model == "rigid")) {
-    NEEDLE_REQUIRE(n.model == "fe" || n.model == "rigid", fmt::format("{}: rigid: true contradicts model '{}'", o.where("rigid"), n.model));
-    n.model = "rigid";
+  for (const NeedleModelEntry& m : needle_models()) {
+    if (m.legacy_key.empty() || !o.boolean(m.legacy_key, n.model == m.name)) continue;
+    NEEDLE_REQUIRE(n.model == default_needle_model().name || n.model == m.name,
+                   fmt::format("{}: {}: true contradicts model '{}'", o.where(m.legacy_key), m.legacy_key, n.model));
+    n.model = m.name;
   }
   o.finish();
 }
@@ -254,8 +256,8 @@ void read_output(SceneObject o, OutputScene& out) {
   o.finish();
 }
 
-Scene scene_from_document(const JsonDocument& doc) {
-  Scene s;
+// start: the values a key left out takes (Scene{}: the defaults).
+Scene scene_from_document(const JsonDocument& doc, Scene s = {}) {
   s.source = doc.source;
   const std::string folder = std::filesystem::path(doc.source).parent_path().string();
   SceneObject root(doc, "", "");
@@ -288,6 +290,13 @@ Scene parse_scene(const std::string& text, const std::string& source) {
 
 Scene read_scene(const std::string& path) { return scene_from_document(read_json_with_lines(path)); }
 
+Scene read_run_scene(const std::string& path) {
+  Scene before;
+  before.tissue.separation.needle_cut = false;           // tissue.contact.cuts_bonds, written since the needle cuts
+  before.tissue.separation.lip = LipReleaseOptions{};  // the lip kept; released, the whole lip (lip_release_mode, _depth_mm)
+  return scene_from_document(read_json_with_lines(path), before);
+}
+
 json scene_to_json(const Scene& s) {
   const NeedleScene& n = s.needle;
   json needle = {{"length_mm", n.length_mm}, {"half_model", n.half_model}};
@@ -301,8 +310,10 @@ json scene_to_json(const Scene& s) {
                     {"edge_size_mm", n.mesh.edge_size_mm}, {"shaft_size_mm", n.mesh.shaft_size_mm}, {"grading_mm", n.mesh.grading_mm}};
   needle["material"] = {{"youngs_modulus_MPa", n.material.youngs_modulus_MPa}, {"poisson_ratio", n.material.poisson_ratio},
                         {"density_g_per_cm3", n.material.density_g_per_mm3 * 1e3}};
-  needle["rigid"] = n.model == "rigid";
-  if (n.model != "fe" && n.model != "rigid") needle["model"] = n.model;
+  // A model selected by its legacy key is written so (stored scenes read the same); another but the default by name.
+  for (const NeedleModelEntry& m : needle_models())
+    if (!m.legacy_key.empty()) needle[m.legacy_key] = n.model == m.name;
+  if (n.model != default_needle_model().name && needle_model(n.model).legacy_key.empty()) needle["model"] = n.model;
   const TissueScene& t = s.tissue;
   json tissue = {
       {"enabled", t.enabled}, {"size_mm", vector_json(t.size_mm)}, {"entry_x_mm", t.entry_x_mm}, {"spacing_mm", t.spacing_mm},

@@ -16,6 +16,7 @@
 #include "solver/separation/separation_models.h"
 #include "solver/tissue/spg_options.h"
 #include "solver/needle/needle_material.h"
+#include "solver/needle/needle_models.h"
 #include "solver/needle/rigid_cannula.h"
 #include "solver/tissue/tissue_material.h"
 
@@ -32,7 +33,7 @@ struct NeedleScene {
   bool half_model = true;   // z >= 0 half with a symmetry plane (paper)
   NeedleMeshOptions mesh;   // T10, 0.2 mm (paper)
   NeedleMaterial material;  // AISI 304
-  std::string model = "fe";  // the needle model (solver/needle/needle_models.h): "fe", "implicit", or "rigid" (no deflection; tissue studies)
+  std::string model = default_needle_model().name;  // a registered needle model (solver/needle/needle_models.h)
 
   // Makes exactly one of these the needle's source (the others, a mesh file and a plain rod cleared).
   void select_source(const std::string& preset_name, double d_a, const std::string& recipe) {
@@ -101,6 +102,11 @@ struct Scene {
 
 // InputError with file, line and key for anything wrong.
 Scene read_scene(const std::string& path);
+// A run folder's scene.json: the effective scene its day's code wrote, every key it knew. A key written only since its
+// default changed stands, when absent, for the model before: no cut by the needle (tissue.contact.cuts_bonds), the
+// lip below the tip point kept (lip_release_mode, since 2026-11-27) and, released, released whole (lip_release_depth_mm,
+// since 2026-11-28). The paper report reads stored runs so.
+Scene read_run_scene(const std::string& path);
 Scene parse_scene(const std::string& text, const std::string& source);
 
 // The effective scene, every key with its canonical unit suffix; reading it back gives the same scene.

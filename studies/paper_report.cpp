@@ -113,10 +113,9 @@ NeedleRun read_run(const std::string& out_dir, const std::string& name) {
   r.particles = s.value("particles", 0L);
   const fs::path scene_path = fs::path(r.folder) / "scene.json";
   if (fs::exists(scene_path)) {
-    const json scene = read_json_file(scene_path.string(), "run scene");
+    const Scene scene = read_run_scene(scene_path.string());
     r.model_description = describe_run_model(scene, r.particles);
-    const json tissue = scene.value("tissue", json::object());
-    r.needle_cuts = tissue.is_object() && tissue.contains("contact") && tissue["contact"].value("cuts_bonds", false);
+    r.needle_cuts = scene.tissue.separation.needle_cut;
   }
   r.history = read_csv_table((fs::path(r.folder) / "history.csv").string());
   r.facets = read_csv_table((fs::path(r.folder) / "facet_forces.csv").string());

@@ -10,6 +10,11 @@
 
 namespace needle {
 
+std::string CuttingOptions::describe() const {
+  if (!enabled()) return "";
+  return fmt::format("cutting the tissue costs work: a pressure of {:g} MPa on the tip facets that advance into it", pressure_MPa);
+}
+
 void CuttingOptions::validate(const std::string& where) const {
   NEEDLE_REQUIRE(std::isfinite(pressure_MPa) && pressure_MPa >= 0,
                  fmt::format("{}: cutting_pressure_MPa must be zero or positive (got {})", where, pressure_MPa));

@@ -29,6 +29,8 @@ struct CuttingOptions {
   std::vector<std::string> facets;   // the surface tags it loads: the tip's ground facets (not a scene key)
   bool enabled() const { return pressure_MPa > 0; }
   void validate(const std::string& where = "cutting") const;  // InputError naming the bad field
+  // The cost of cutting in a run's one-line description (the paper report); empty when off, the default.
+  std::string describe() const;
 };
 
 class CuttingResistance : public NeedleLoads {

@@ -12,6 +12,13 @@
 
 namespace needle {
 
+std::string ContactOptions::describe() const {
+  const ContactOptions defaults;
+  if (skin_mm == defaults.skin_mm && stiffness_factor == defaults.stiffness_factor) return "";
+  return fmt::format("the contact's skin is {:g} mm and its stiffness factor {:g} (the defaults: {:g} and {:g})", skin_mm, stiffness_factor,
+                     defaults.skin_mm, defaults.stiffness_factor);
+}
+
 void ContactOptions::validate(const std::string& where) const {
   contact_law(law, where + ".law");  // InputError for an unknown law
   NEEDLE_REQUIRE(std::isfinite(friction) && friction >= 0, fmt::format("{}: friction must be zero or positive (got {})", where, friction));

@@ -39,6 +39,9 @@ struct ContactOptions {
   double needle_stiffness_scale = 0.1;  // cap of k on the needle's side, x m_c / dt_needle^2
   double voxel_mm = 0.02;         // the needle level set's resolution
   void validate(const std::string& where = "contact") const;  // InputError naming the bad field
+  // The skin and stiffness in a run's one-line description (the paper report); empty at the defaults. (The law is
+  // said with the needle model: runs/model_levels.h.)
+  std::string describe() const;
 };
 
 // Force on the needle booked on one facet tag.

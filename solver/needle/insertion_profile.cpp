@@ -3,10 +3,24 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
+#include <string>
+#include <vector>
 
 #include "core/input_error.h"
 
 namespace needle {
+
+std::string InsertionProfile::describe() const {
+  const InsertionProfile paper;
+  std::vector<std::string> parts;
+  if (speed_mm_per_ms != paper.speed_mm_per_ms)
+    parts.push_back(fmt::format("the needle is driven at {:g} m/s (the paper's model: {:g})", speed_mm_per_ms, paper.speed_mm_per_ms));
+  if (decel_time_ms != paper.decel_time_ms) parts.push_back(fmt::format("the base decelerates to rest over {:g} ms", decel_time_ms));
+  if (hold_ms != paper.hold_ms) parts.push_back(fmt::format("delta is read after the base is held still for {:g} ms", hold_ms));
+  std::string d;
+  for (const std::string& p : parts) d += (d.empty() ? "" : "; ") + p;
+  return d;
+}
 
 void InsertionProfile::validate(const std::string& where) const {
   NEEDLE_REQUIRE(std::isfinite(accel_time_ms) && accel_time_ms >= 0,

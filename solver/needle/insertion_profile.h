@@ -21,6 +21,9 @@ struct InsertionProfile {
 
   // InputError naming the field for non-positive values or a travel shorter than the two ramps.
   void validate(const std::string& where = "motion") const;
+  // The drive in a run's one-line description (the paper report): its speed, a stop or a hold where they are not the
+  // paper's model's (8 m/s, read at full speed), "; " between them; empty for the paper's.
+  std::string describe() const;
   double cruise_end_time_ms() const;  // when the deceleration starts (the travel's end without one)
   double travel_end_time_ms() const;  // when the travel is reached
   double end_time_ms() const;  // the travel's end plus the hold

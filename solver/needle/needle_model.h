@@ -40,7 +40,7 @@ class NeedleModel {
  public:
   virtual ~NeedleModel() = default;
 
-  // The registered name (needle_models.h): "fe", "rigid".
+  // The name it is registered under (needle_models.h).
   virtual std::string name() const = 0;
   // The mesh in its reference configuration (X, the surface's tags) and its lumped nodal masses.
   virtual const TetMesh& mesh() const = 0;

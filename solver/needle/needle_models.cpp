@@ -36,10 +36,12 @@ const std::vector<NeedleModelEntry>& needle_models() {
       {"implicit", "the same mesh, linear elastic, implicit Newmark steps on a factored matrix at the coupling step: no subcycling",
        "the implicit linear needle", false, false, true, make_implicit},
       {"rigid", "every node follows the drive: no deflection, no cannula, no step limit", "the rigid needle", false, false, false,
-       make_rigid},
+       make_rigid, "rigid"},
   };
   return models;
 }
+
+const NeedleModelEntry& default_needle_model() { return needle_models().front(); }
 
 const NeedleModelEntry& needle_model(const std::string& name, const std::string& where) {
   for (const NeedleModelEntry& m : needle_models())

@@ -29,7 +29,13 @@ struct NeedleModelEntry {
   // contact law must keep them constant over it, and the tissue's mass scaling aims at a share of its step.
   bool takes_coupling_step;
   std::unique_ptr<NeedleModel> (*make)(const NeedleModelInputs& inputs);
+  // The needle section's boolean key that is an older way to select it (`rigid: true`), or empty. A scene reads the key,
+  // and its effective scene still writes it, so that stored scenes read the same.
+  std::string legacy_key = {};
 };
+
+// The model a scene's needle runs when it names none (the first registered: the explicit FE needle).
+const NeedleModelEntry& default_needle_model();
 
 // The registered models, in the order --help lists them.
 const std::vector<NeedleModelEntry>& needle_models();

@@ -26,6 +26,16 @@ LipReleaseMode lip_release_mode_from_name(const std::string& name) {
   throw InputError("must be crushed, free or off (got '" + name + "')");
 }
 
+std::string LipReleaseOptions::describe(const LipReleaseOptions& unnamed) const {
+  if (mode == unnamed.mode && below_mm == unnamed.below_mm && depth_mm == unnamed.depth_mm) return "";
+  if (mode == LipReleaseMode::off) return "the lip below the tip point stays as the tissue is (no lip release)";
+  const std::string released = mode == LipReleaseMode::free ? "is cut loose (lip release free)" : "is crushed (lip release)";
+  if (whole_lip()) return "the whole lip below the tip point " + released;
+  return fmt::format("the tissue the tip meets from {:g} mm below its tip point", below_mm) +
+         (std::isfinite(depth_mm) ? fmt::format(" to {:g} mm", below_mm + depth_mm) : std::string(" down to the rod's bottom")) +
+         ", inside the rod's outline, " + released;
+}
+
 void LipReleaseOptions::validate(const std::string& where) const {
   NEEDLE_REQUIRE(depth_mm > 0, fmt::format("{}: depth_mm must be positive (got {}; leave it out for the whole lip)", where, depth_mm));
   NEEDLE_REQUIRE(std::isfinite(below_mm) && below_mm >= 0, fmt::format("{}: below_mm must be zero or positive (got {})", where, below_mm));

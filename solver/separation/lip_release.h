@@ -49,6 +49,8 @@ struct LipReleaseOptions {
   bool enabled() const { return mode != LipReleaseMode::off; }
   bool whole_lip() const { return below_mm == 0 && depth_mm == std::numeric_limits<double>::infinity(); }
   void validate(const std::string& where = "lip_release") const;  // InputError naming the bad field
+  // The lip in a run's one-line description (the paper report); empty when it is `unnamed` (a scene's default).
+  std::string describe(const LipReleaseOptions& unnamed) const;
 };
 
 constexpr double kNoLipMm = 1e-6;  // a lip thinner than this is none (a tip point on the rod's bottom)

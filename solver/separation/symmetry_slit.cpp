@@ -10,6 +10,11 @@
 
 namespace needle {
 
+std::string SymmetrySlitOptions::describe() const {
+  if (!enabled()) return "";
+  return fmt::format("the tissue also splits in the symmetry plane behind the tip, {:g} mm either side of the rod's axis", half_height_mm);
+}
+
 void SymmetrySlitOptions::validate(const std::string& where) const {
   NEEDLE_REQUIRE(std::isfinite(half_height_mm) && half_height_mm >= 0,
                  fmt::format("{}: half_height_mm must be zero (no slit) or positive (got {})", where, half_height_mm));

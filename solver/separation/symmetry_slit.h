@@ -29,6 +29,8 @@ struct SymmetrySlitOptions {
   double lead_mm = 0.0;         // the slit's front runs this far ahead of the tip point (>= 0)
   bool enabled() const { return half_height_mm > 0; }
   void validate(const std::string& where = "slit") const;  // InputError naming the bad field
+  // The slit in a run's one-line description (the paper report); empty when off, the default.
+  std::string describe() const;
 };
 
 class SymmetrySlit : public SeparationModel {

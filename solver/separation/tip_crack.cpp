@@ -3,11 +3,20 @@
 #include <chrono>
 #include <cmath>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include "core/input_error.h"
 
 namespace needle {
+
+std::string TipCrackOptions::describe() const {
+  if (!enabled()) return "";
+  std::string d = fmt::format("the tip drives a crack past the rod: fins from the tip point at {} deg in the cross-section (0: horizontal), {:g} mm long",
+                              fmt::join(angles_deg, ", "), reach_mm);
+  if (lead_mm > 0) d += fmt::format(", running {:g} mm ahead of the tip", lead_mm);
+  return d;
+}
 
 void TipCrackOptions::validate(const std::string& where) const {
   NEEDLE_REQUIRE(std::isfinite(reach_mm) && reach_mm >= 0,

@@ -34,6 +34,8 @@ struct TipCrackOptions {
   double lead_mm = 0.0;                // the crack's front runs this far ahead of A (>= 0)
   bool enabled() const { return reach_mm > 0; }
   void validate(const std::string& where = "crack") const;  // InputError naming the bad field
+  // The crack in a run's one-line description (the paper report); empty when off, the default.
+  std::string describe() const;
 };
 
 class TipCrack : public SeparationModel {

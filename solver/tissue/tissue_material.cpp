@@ -37,6 +37,15 @@ std::string rate_law_name(RateLaw law) {
   return "off";
 }
 
+std::string TissueMaterial::describe() const {
+  std::string d;
+  if (law == TissueLaw::stiffening_elastic) d = "the tissue stiffens as measured (stiffening_elastic: 3 G eps + k eps^n)";
+  if (viscoelastic())
+    d += (d.empty() ? "" : "; ") + fmt::format("the gel relaxes viscoelastically ({:g} of the shear stress, time constant {:g} ms)",
+                                               relaxing_shear_fraction, relaxation_time_ms);
+  return d;
+}
+
 void TissueMaterial::validate() const {
   auto finite_positive = [](double v) { return std::isfinite(v) && v > 0; };
   NEEDLE_REQUIRE(finite_positive(E_MPa), fmt::format("tissue E_MPa must be a positive modulus (got {})", E_MPa));

@@ -57,6 +57,9 @@ struct TissueMaterial {
 
   // InputError naming the bad field: E <= 0, nu outside (-1, 0.5), density <= 0, k <= 0, n <= 1, ...
   void validate() const;  // also g outside [0, 1), tau <= 0
+  // The law and the relaxation in a run's one-line description (the paper report), "; " between them; empty for the
+  // paper's card's (MAT_018, no relaxation), which goes unnamed.
+  std::string describe() const;
 
   double density_g_per_mm3() const { return density_g_per_cm3 * 1e-3; }
   double shear_modulus_MPa() const { return E_MPa / (2 * (1 + nu)); }
