@@ -16,9 +16,9 @@ const std::vector<SceneFlagRow>& scene_flag_rows() {
       {"--mesh-size-mm", "needle.mesh.size_mm", T::value, "", "Needle mesh size over the tip and groove (run default 0.4; scene key needle.mesh.size_mm)"},
       {"--path-refinement", "tissue.path_refinement", T::value, "",
        "Particles this many times finer within 1.2 mm of the needle's path (default: the scene's; scene key tissue.path_refinement)"},
-      {"--no-needle-cut", "tissue.contact.cuts_bonds", T::nothing, "false",
+      {"--no-needle-cut", "tissue.separation.needle_cut", T::nothing, "false",
        "The needle does not cut the bonds its body crosses; the tissue separates by bond failure alone, as in the paper's "
-       "model (scene key tissue.contact.cuts_bonds)"},
+       "model (scene key tissue.separation.needle_cut)"},
       {"--tissue-nu", "tissue.material.nu", T::value, "", "Tissue Poisson ratio (the paper's 0.45; scene key tissue.material.nu)"},
       {"--tissue-friction", "tissue.friction", T::value, "", "Needle-tissue friction coefficient (the paper's 0.18; scene key tissue.friction)"},
       {"--tissue-law", "tissue.material.law", T::value, "",
@@ -38,29 +38,29 @@ const std::vector<SceneFlagRow>& scene_flag_rows() {
        "The tissue block's length x, height y (centred on the path) and half width z, e.g. 40,16,6 (the paper's "
        "40,8,2; the experiment's phantom: 100 long, 30 high, 80 wide; the faces y = +-Y/2 and z = Z are fixed; scene key tissue.size_mm)",
        3},
-      {"--slit-half-height-mm", "tissue.contact.slit_half_height_mm", T::value, "",
+      {"--slit-half-height-mm", "tissue.separation.slit.half_height_mm", T::value, "",
        "The tissue also opens in the symmetry plane behind the tip point, within this distance of the rod's axis, so the "
        "needle can push it aside instead of only up and down (0.5: as tall as the rod; default 0: no slit; scene key "
-       "tissue.contact.slit_half_height_mm; half models only)"},
+       "tissue.separation.slit.half_height_mm; half models only)"},
       {"--relaxing-shear-fraction", "tissue.material.relaxing_shear_fraction", T::value, "",
        "Viscoelastic gel: this share g of the shear stress relaxes, s(t) = s0 (1 - g (1 - exp(-t/tau))) under a held strain; "
        "E stays the instantaneous modulus (default 0: the paper's card, no relaxation; scene key "
        "tissue.material.relaxing_shear_fraction)"},
       {"--relaxation-time-ms", "tissue.material.relaxation_time_ms", T::value, "",
        "The relaxation's time constant tau (default 1 ms; scene key tissue.material.relaxation_time_ms)"},
-      {"--cutting-pressure-mpa", "tissue.contact.cutting_pressure_MPa", T::value, "",
+      {"--cutting-pressure-mpa", "tissue.cutting.pressure_MPa", T::value, "",
        "Cutting resistance: a pressure on the tip facets that advance into the tissue, the work of separating it "
-       "(default 0: cutting costs nothing, as in the paper's model; scene key tissue.contact.cutting_pressure_MPa)"},
-      {"--crack-reach-mm", "tissue.contact.crack_reach_mm", T::value, "",
+       "(default 0: cutting costs nothing, as in the paper's model; scene key tissue.cutting.pressure_MPa)"},
+      {"--crack-reach-mm", "tissue.separation.crack.reach_mm", T::value, "",
        "The tip drives a crack past the rod's outline: the bonds across planar fins that leave tip point A are cut as the "
        "tip passes, up to this distance from A (the rod's radius is 0.5; default 0: the tissue separates along the "
-       "needle's surface only; scene key tissue.contact.crack_reach_mm)"},
-      {"--crack-angles-deg", "tissue.contact.crack_angles_deg", T::list, "",
+       "needle's surface only; scene key tissue.separation.crack.reach_mm)"},
+      {"--crack-angles-deg", "tissue.separation.crack.angles_deg", T::list, "",
        "The crack's fins, as directions in the cross-section from A: 0 toward +z (a horizontal crack at A's height), "
-       "90 up, -90 down, e.g. 0 or 48,-55 (default 0; scene key tissue.contact.crack_angles_deg)"},
-      {"--crack-lead-mm", "tissue.contact.crack_lead_mm", T::value, "",
+       "90 up, -90 down, e.g. 0 or 48,-55 (default 0; scene key tissue.separation.crack.angles_deg)"},
+      {"--crack-lead-mm", "tissue.separation.crack.lead_mm", T::value, "",
        "The crack's front runs this far ahead of tip point A, so the gel splits before the tip reaches it (default 0: "
-       "it opens as the tip passes; scene key tissue.contact.crack_lead_mm)"},
+       "it opens as the tip passes; scene key tissue.separation.crack.lead_mm)"},
       {"--groove-start-mm", "needle.groove_start_mm", T::value, "",
        "The groove's front wall this far behind tip point A. The paper does not give it; the presets' 3 mm clears the SB "
        "bevel's heel (2.3 mm) (default: the recipe's; scene key needle.groove_start_mm)"},

@@ -218,9 +218,14 @@ bool folder_holds_run_of(const Scene& scene, const std::string& folder_name) {
   try {
     // A run stopped by Ctrl-C holds what it had so far, not a result: it runs again.
     if (json::parse(summary).value("status", std::string()) == "interrupted") return false;
-    return without_threads(json::parse(stored)) == without_threads(json::parse(scene_to_json(scene).dump()));
+    // The stored scene read as a run's (runs/scene.h: an older layout or older keys read as what they meant), written
+    // again as today's effective scene, against this scene's.
+    return without_threads(json::parse(scene_to_json(read_run_scene((folder / "scene.json").string())).dump())) ==
+           without_threads(json::parse(scene_to_json(scene).dump()));
   } catch (const json::exception&) {
     return false;  // an unreadable folder holds no run
+  } catch (const InputError&) {
+    return false;  // nor one whose scene this code cannot read
   }
 }
 

@@ -22,6 +22,8 @@ void drive_run(const Scene& scene, const RunOptions& o, const std::function<std:
   if (const int signal = interrupts.signal())
     throw Interrupted(signal, fmt::format("interrupted by {} while the model was built; nothing written", signal_name(signal)));
   if (!o.quiet && !o.note.empty()) fmt::print("{}\n", o.note);
+  if (!o.quiet)
+    for (const std::string& note : scene.notes) fmt::print(stderr, "needle: note: {}\n", note);
   RunFolder folder(o.out_dir, o.overwrite);
   std::filesystem::create_directories(folder.path("frames"));
   RunLog log(folder.path("run.log"));
@@ -31,6 +33,7 @@ void drive_run(const Scene& scene, const RunOptions& o, const std::function<std:
   }
   log.line(fmt::format("scene {}", scene.source));
   if (!o.note.empty()) log.line(o.note);
+  for (const std::string& note : scene.notes) log.line("note: " + note);
   for (const std::string& line : model.setup_log()) log.line(line);
 
   const double end_ms = model.end_time_ms();

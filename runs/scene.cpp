@@ -4,11 +4,13 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <optional>
 #include <fmt/format.h>
 
 #include "runs/json_lines.h"
 #include "runs/material_json.h"
 #include "runs/scene_object.h"
+#include "runs/scene_key_spellings.h"
 #include "core/input_error.h"
 #include "core/units.h"
 #include "solver/contact/contact_laws.h"
@@ -118,7 +120,78 @@ void read_cannula(SceneObject o, CannulaOptions& c) {
   o.finish();
 }
 
-void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc) {
+// One separation model's keys ("slit", "crack" or "lip"), each named prefix + its name: in its own section (no prefix)
+// or in the contact section as scenes wrote them until 2026-11-28 ("crack_", "lip_release_").
+void read_separation_model(SceneObject& o, const std::string& model, const std::string& prefix, SeparationOptions& s) {
+  const std::string p = prefix;
+  if (model == "slit") {
+    s.slit.half_height_mm = o.quantity(p + "half_height", Dimension::length, s.slit.half_height_mm, non_negative());
+    s.slit.lead_mm = o.quantity(p + "lead", Dimension::length, s.slit.lead_mm, non_negative());
+  } else if (model == "crack") {
+    s.crack.reach_mm = o.quantity(p + "reach", Dimension::length, s.crack.reach_mm, non_negative());
+    s.crack.angles_deg = o.numbers(p + "angles_deg", s.crack.angles_deg, within(-180.0, 180.0));
+    s.crack.lead_mm = o.quantity(p + "lead", Dimension::length, s.crack.lead_mm, non_negative());
+  } else {
+    // The band's depth: a length, or "whole lip" (down to the rod's bottom, however thick the lip).
+    const std::string depth_key = p + "depth_mm";
+    if (o.has(depth_key) && o.raw(depth_key).is_string()) {
+      const std::string depth = o.raw(depth_key).get<std::string>();
+      NEEDLE_REQUIRE(depth == kWholeLipText, fmt::format("{}: give a depth in mm or \"{}\" (got \"{}\")", o.where(depth_key), kWholeLipText, depth));
+      s.lip.depth_mm = std::numeric_limits<double>::infinity();
+    } else {
+      s.lip.depth_mm = o.quantity(p + "depth", Dimension::length, s.lip.depth_mm, positive());
+    }
+    s.lip.below_mm = o.quantity(p + "below", Dimension::length, s.lip.below_mm, non_negative());
+    const std::string mode = o.text(p + "mode", lip_release_mode_name(s.lip.mode));
+    try {
+      s.lip.mode = lip_release_mode_from_name(mode);
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("{}: {}", o.where(p + "mode"), e.what()));
+    }
+  }
+}
+
+void read_cutting(SceneObject& o, const std::string& prefix, CuttingOptions& c) {
+  c.pressure_MPa = o.quantity(prefix + "pressure", Dimension::stress, c.pressure_MPa, non_negative());
+}
+
+// The first of these JSON pointers the document holds (the last if none), and the dotted key it names.
+std::string first_given(const JsonDocument& doc, const std::vector<std::string>& pointers) {
+  for (const std::string& p : pointers)
+    if (doc.value.contains(json::json_pointer(p))) return p;
+  return pointers.back();
+}
+std::string key_name(const std::string& pointer) {
+  std::string key = pointer.substr(1);
+  std::replace(key.begin(), key.end(), '/', '.');
+  return key;
+}
+
+// The separation's and cutting's keys written in the contact section the older way: read as their sections' keys, with
+// a note each; given in both places they are refused.
+void read_older_contact_keys(SceneObject& c, const JsonDocument& doc, TissueScene& t, std::vector<std::string>& notes) {
+  for (const auto& item : doc.value.at(json::json_pointer("/tissue/contact")).items()) {
+    const std::optional<KeySpelling> now = current_contact_key(item.key());
+    if (!now) continue;
+    std::string section = "/tissue/" + now->section;
+    std::replace(section.begin(), section.end(), '.', '/');
+    // Any spelling of the same quantity in its section: "reach_mm" or "reach".
+    if (doc.value.contains(json::json_pointer(section)) && doc.value.at(json::json_pointer(section)).is_object())
+      for (const auto& given : doc.value.at(json::json_pointer(section)).items()) {
+        const std::string pointer = section + "/" + json_pointer_token(given.key());
+        NEEDLE_REQUIRE(key_quantity(given.key()) != now->quantity,
+                       fmt::format("{}: give {} or tissue.contact.{} (its older spelling), not both", doc.where(pointer), key_name(pointer), item.key()));
+      }
+    notes.push_back(older_spelling_note(doc.where("/tissue/contact/" + json_pointer_token(item.key())), item.key(), *now));
+  }
+  t.separation.needle_cut = c.boolean("cuts_bonds", t.separation.needle_cut);
+  read_separation_model(c, "slit", "slit_", t.separation);
+  read_separation_model(c, "crack", "crack_", t.separation);
+  read_separation_model(c, "lip", "lip_release_", t.separation);
+  read_cutting(c, "cutting_", t.cutting);
+}
+
+void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc, std::vector<std::string>& notes) {
   t.enabled = o.boolean("enabled", t.enabled);
   t.size_mm = o.vector3("size_mm", t.size_mm);
   NEEDLE_REQUIRE((t.size_mm.array() > 0).all(), fmt::format("{} must be three positive lengths", o.where("size_mm")));
@@ -179,6 +252,24 @@ void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc) {
     t.spg.cfl = g.number("cfl", t.spg.cfl, within(1e-3, 1.0));
     g.finish();
   }
+  // The separation models and the cost of cutting: in sections that mirror their structs, or, as scenes wrote them
+  // until 2026-11-28, in the contact section with a prefix (runs/scene_key_spellings.h), read so with a note.
+  if (o.has("separation")) {
+    SceneObject sep = o.child("separation");
+    t.separation.needle_cut = sep.boolean("needle_cut", t.separation.needle_cut);
+    for (const char* model : {"slit", "crack", "lip"}) {
+      if (!sep.has(model)) continue;
+      SceneObject m = sep.child(model);
+      read_separation_model(m, model, "", t.separation);
+      m.finish();
+    }
+    sep.finish();
+  }
+  if (o.has("cutting")) {
+    SceneObject c = o.child("cutting");
+    read_cutting(c, "", t.cutting);
+    c.finish();
+  }
   if (o.has("contact")) {
     SceneObject c = o.child("contact");
     t.contact.law = c.text("law", t.contact.law);
@@ -188,37 +279,17 @@ void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc) {
     t.contact.voxel_mm = c.quantity("voxel", Dimension::length, t.contact.voxel_mm, within(1e-3, 0.2));
     t.contact.damping_ratio = c.number("damping_ratio", t.contact.damping_ratio, within(0.0, 1.0));
     t.contact.needle_stiffness_scale = c.number("needle_stiffness_scale", t.contact.needle_stiffness_scale, within(1e-6, 0.5));
-    t.separation.needle_cut = c.boolean("cuts_bonds", t.separation.needle_cut);
-    t.separation.slit.half_height_mm = c.quantity("slit_half_height", Dimension::length, t.separation.slit.half_height_mm, non_negative());
-    t.separation.slit.lead_mm = c.quantity("slit_lead", Dimension::length, t.separation.slit.lead_mm, non_negative());
-    t.cutting.pressure_MPa = c.quantity("cutting_pressure", Dimension::stress, t.cutting.pressure_MPa, non_negative());
-    t.separation.crack.reach_mm = c.quantity("crack_reach", Dimension::length, t.separation.crack.reach_mm, non_negative());
-    t.separation.crack.angles_deg = c.numbers("crack_angles_deg", t.separation.crack.angles_deg, within(-180.0, 180.0));
-    t.separation.crack.lead_mm = c.quantity("crack_lead", Dimension::length, t.separation.crack.lead_mm, non_negative());
-    // The crack's shape without a crack would be dropped from scene.json without a word.
-    NEEDLE_REQUIRE(t.separation.crack.enabled() || (t.separation.crack.angles_deg == TipCrackOptions{}.angles_deg &&
-                                                    t.separation.crack.lead_mm == TipCrackOptions{}.lead_mm),
-                   fmt::format("{}: the crack's shape (crack_angles_deg, crack_lead_mm) needs a crack: crack_reach_mm above 0",
-                               c.where(c.has("crack_angles_deg") ? "crack_angles_deg" : "crack_lead_mm")));
-    // The band's depth: a length, or "whole lip" (down to the rod's bottom, however thick the lip).
-    if (c.has("lip_release_depth_mm") && c.raw("lip_release_depth_mm").is_string()) {
-      const std::string depth = c.raw("lip_release_depth_mm").get<std::string>();
-      NEEDLE_REQUIRE(depth == kWholeLipText, fmt::format("{}: give a depth in mm or \"{}\" (got \"{}\")", c.where("lip_release_depth_mm"),
-                                                        kWholeLipText, depth));
-      t.separation.lip.depth_mm = std::numeric_limits<double>::infinity();
-    } else {
-      t.separation.lip.depth_mm = c.quantity("lip_release_depth", Dimension::length, t.separation.lip.depth_mm, positive());
-    }
-    t.separation.lip.below_mm = c.quantity("lip_release_below", Dimension::length, t.separation.lip.below_mm, non_negative());
-    {
-      const std::string mode = c.text("lip_release_mode", lip_release_mode_name(t.separation.lip.mode));
-      try {
-        t.separation.lip.mode = lip_release_mode_from_name(mode);
-      } catch (const InputError& e) {
-        throw InputError(fmt::format("{}: {}", c.where("lip_release_mode"), e.what()));
-      }
-    }
+    read_older_contact_keys(c, doc, t, notes);
     c.finish();
+  }
+  // The crack's shape without a crack would be dropped from scene.json without a word.
+  if (!t.separation.crack.enabled() &&
+      (t.separation.crack.angles_deg != TipCrackOptions{}.angles_deg || t.separation.crack.lead_mm != TipCrackOptions{}.lead_mm)) {
+    const std::string pointer = first_given(doc, {"/tissue/separation/crack/angles_deg", "/tissue/separation/crack/lead_mm",
+                                                  "/tissue/separation/crack/lead", "/tissue/contact/crack_angles_deg",
+                                                  "/tissue/contact/crack_lead_mm", "/tissue/contact/crack_lead"});
+    throw InputError(fmt::format("{}: {}: the crack's shape (its angles and lead) needs a crack: tissue.separation.crack.reach_mm above 0",
+                                 doc.where(pointer), key_name(pointer)));
   }
   // A shifted block keeps the path (y = z = 0) inside it, with a rod's radius to spare.
   NEEDLE_REQUIRE(t.offset_y_mm == 0 || std::abs(t.offset_y_mm) + 0.5 < 0.5 * t.size_mm.y(),
@@ -265,15 +336,18 @@ Scene scene_from_document(const JsonDocument& doc, Scene s = {}) {
   else s.needle.preset = "SB";
   if (root.has("motion")) read_motion(root.child("motion"), s);
   if (root.has("cannula")) read_cannula(root.child("cannula"), s.cannula);
-  if (root.has("tissue")) read_tissue(root.child("tissue"), s.tissue, doc);
+  if (root.has("tissue")) read_tissue(root.child("tissue"), s.tissue, doc, s.notes);
   if (root.has("solver")) read_solver(root.child("solver"), s.solver);
   if (root.has("output")) read_output(root.child("output"), s.output);
   root.text("description", "");
   root.finish();
   // What one section's keys mean for another's.
-  NEEDLE_REQUIRE(!s.tissue.separation.slit.enabled() || s.needle.half_model,
-                 fmt::format("{}: tissue.contact.slit_half_height_mm: the slit opens the symmetry plane, so it needs a half model "
-                             "(needle.half_model true)", doc.where("/tissue/contact/slit_half_height_mm")));
+  if (s.tissue.separation.slit.enabled() && !s.needle.half_model) {
+    const std::string slit = first_given(doc, {"/tissue/separation/slit/half_height_mm", "/tissue/separation/slit/half_height",
+                                               "/tissue/contact/slit_half_height_mm", "/tissue/contact/slit_half_height"});
+    throw InputError(fmt::format("{}: {}: the slit opens the symmetry plane, so it needs a half model (needle.half_model true)",
+                                 doc.where(slit), key_name(slit)));
+  }
   NEEDLE_REQUIRE(!s.tissue.enabled || s.tissue.entry_x_mm < s.motion.travel_mm,
                  fmt::format("{}: tissue.entry_x_mm {} mm is not less than the travel ({} mm): the tip would never reach the tissue",
                              doc.where("/tissue/entry_x_mm"), s.tissue.entry_x_mm, s.motion.travel_mm));
@@ -333,29 +407,24 @@ json scene_to_json(const Scene& s) {
                {"crack_face_min_volume_ratio", t.spg.crack_face_min_volume_ratio},
                {"cfl", t.spg.cfl}}},
       {"contact", {{"stiffness_factor", t.contact.stiffness_factor}, {"skin_mm", t.contact.skin_mm}, {"voxel_mm", t.contact.voxel_mm},
-                   {"damping_ratio", t.contact.damping_ratio}, {"needle_stiffness_scale", t.contact.needle_stiffness_scale},
-                   {"cuts_bonds", t.separation.needle_cut}}}};
-  // Written only when used: stored scenes (no slit) stay as they were.
-  if (t.separation.slit.enabled()) {
-    tissue["contact"]["slit_half_height_mm"] = t.separation.slit.half_height_mm;
-    tissue["contact"]["slit_lead_mm"] = t.separation.slit.lead_mm;
-  }
-  if (t.cutting.pressure_MPa > 0) tissue["contact"]["cutting_pressure_MPa"] = t.cutting.pressure_MPa;
+                   {"damping_ratio", t.contact.damping_ratio}, {"needle_stiffness_scale", t.contact.needle_stiffness_scale}}}};
   if (t.offset_y_mm != 0) tissue["offset_y_mm"] = t.offset_y_mm;
   if (t.contact.law != ContactOptions{}.law) tissue["contact"]["law"] = t.contact.law;
-  if (t.separation.crack.enabled()) {
-    tissue["contact"]["crack_reach_mm"] = t.separation.crack.reach_mm;
-    tissue["contact"]["crack_angles_deg"] = t.separation.crack.angles_deg;
-    tissue["contact"]["crack_lead_mm"] = t.separation.crack.lead_mm;
-  }
-  // The lip's mode is always written (its default changed on 2026-11-27: a scene says which model made it), and so
-  // is a released lip's depth (its default changed on 2026-11-28, from the whole lip to 0.45 mm); the band's top only
-  // when it is not at the tip point.
-  tissue["contact"]["lip_release_mode"] = lip_release_mode_name(t.separation.lip.mode);
-  if (t.separation.lip.enabled() && t.separation.lip.below_mm != 0) tissue["contact"]["lip_release_below_mm"] = t.separation.lip.below_mm;
-  if (t.separation.lip.enabled())
-    tissue["contact"]["lip_release_depth_mm"] =
-        std::isfinite(t.separation.lip.depth_mm) ? json(t.separation.lip.depth_mm) : json(kWholeLipText);
+  // The separation models as SeparationOptions holds them: the needle's cut always; a slit or a crack only when on.
+  // The lip's mode is always written (its default changed on 2026-11-27: a scene says which model made it), and so is
+  // a released lip's depth (its default changed on 2026-11-28, from the whole lip to 0.45 mm); the band's top only when
+  // it is not at the tip point.
+  json separation = {{"needle_cut", t.separation.needle_cut}};
+  if (t.separation.slit.enabled())
+    separation["slit"] = {{"half_height_mm", t.separation.slit.half_height_mm}, {"lead_mm", t.separation.slit.lead_mm}};
+  if (t.separation.crack.enabled())
+    separation["crack"] = {{"reach_mm", t.separation.crack.reach_mm}, {"angles_deg", t.separation.crack.angles_deg},
+                           {"lead_mm", t.separation.crack.lead_mm}};
+  json& lip = separation["lip"] = {{"mode", lip_release_mode_name(t.separation.lip.mode)}};
+  if (t.separation.lip.enabled() && t.separation.lip.below_mm != 0) lip["below_mm"] = t.separation.lip.below_mm;
+  if (t.separation.lip.enabled()) lip["depth_mm"] = std::isfinite(t.separation.lip.depth_mm) ? json(t.separation.lip.depth_mm) : json(kWholeLipText);
+  tissue["separation"] = separation;
+  if (t.cutting.enabled()) tissue["cutting"] = {{"pressure_MPa", t.cutting.pressure_MPa}};
   const CannulaOptions& c = s.cannula;
   json motion = {{"accel_time_ms", s.motion.accel_time_ms}, {"speed_m_per_s", s.motion.speed_mm_per_ms}, {"travel_mm", s.motion.travel_mm},
                  {"direction", vector_json(s.direction)}};
@@ -392,24 +461,6 @@ json scene_to_json(const Scene& s) {
   };
 }
 
-}  // namespace needle
-
-namespace needle {
-
-namespace {
-
-// A key without its unit suffix: the quantity it names. "travel_mm" and "travel" name one quantity (a setting of one
-// replaces the other); "stabilization" and "stabilization_coefficient" name two.
-std::string quantity_of_key(const std::string& key) {
-  for (Dimension d : {Dimension::length, Dimension::time, Dimension::speed, Dimension::stress, Dimension::density, Dimension::angle}) {
-    const std::string suffix = canonical_suffix(d);
-    if (key.size() > suffix.size() && key.compare(key.size() - suffix.size(), suffix.size(), suffix) == 0) return key.substr(0, key.size() - suffix.size());
-  }
-  return key;
-}
-
-}  // namespace
-
 Scene apply_scene_settings(const Scene& scene, const std::vector<std::string>& settings, const std::string& source) {
   std::vector<NamedSceneSetting> named;
   for (const std::string& setting : settings) named.push_back({setting, source.empty() ? setting : source + " " + setting});
@@ -419,11 +470,13 @@ Scene apply_scene_settings(const Scene& scene, const std::vector<std::string>& s
 Scene apply_named_scene_settings(const Scene& scene, const std::vector<NamedSceneSetting>& settings) {
   if (settings.empty()) return scene;
   json j = scene_to_json(scene);
-  std::vector<std::string> keys;
+  std::vector<std::string> keys, notes;
   for (const auto& [setting, shown] : settings) {
     const size_t eq = setting.find('=');
     NEEDLE_REQUIRE(eq != std::string::npos && eq > 0, fmt::format("{}: give key=value, e.g. {}", shown, "--set tissue.material.E_MPa=0.1"));
-    const std::string key = setting.substr(0, eq), value = setting.substr(eq + 1);
+    // A key in an older spelling sets the key it is now (tissue.contact.crack_reach_mm: tissue.separation.crack.reach_mm).
+    const std::string given = setting.substr(0, eq), key = current_scene_key(given), value = setting.substr(eq + 1);
+    if (key != given) notes.push_back(fmt::format("{}: {} is read as {} (its place since 2026-11-28; docs/scenes.md)", shown, given, key));
     keys.push_back(key);
     std::vector<std::string> path;
     for (size_t start = 0;;) {
@@ -446,7 +499,7 @@ Scene apply_named_scene_settings(const Scene& scene, const std::vector<NamedScen
     for (auto it = section->begin(); it != section->end();) {
       const std::string& other = it.key();
       // The same quantity in another unit spelling only: a longer key that merely begins with this one stays.
-      const bool same_key = quantity_of_key(other) == quantity_of_key(leaf);
+      const bool same_key = key_quantity(other) == key_quantity(leaf);
       const bool other_source = is_source && std::find(sources.begin(), sources.end(), other) != sources.end();
       it = (same_key || other_source) && !it.value().is_object() ? section->erase(it) : std::next(it);
     }
@@ -456,6 +509,8 @@ Scene apply_named_scene_settings(const Scene& scene, const std::vector<NamedScen
   try {
     Scene out = parse_scene(j.dump(2), "--set");
     out.source = scene.source;
+    out.notes = scene.notes;
+    out.notes.insert(out.notes.end(), notes.begin(), notes.end());
     return out;
   } catch (const InputError& e) {
     // The reader names "--set:LINE: key: problem"; the line is of the generated text, so say what was set instead:
@@ -467,7 +522,7 @@ Scene apply_named_scene_settings(const Scene& scene, const std::vector<NamedScen
     for (size_t k = 0; k < settings.size(); ++k) {
       all += (all.empty() ? "" : " ") + settings[k].shown;
       const size_t dot = keys[k].rfind('.');
-      const std::string quantity = (dot == std::string::npos ? std::string() : keys[k].substr(0, dot + 1)) + quantity_of_key(keys[k].substr(dot + 1));
+      const std::string quantity = (dot == std::string::npos ? std::string() : keys[k].substr(0, dot + 1)) + key_quantity(keys[k].substr(dot + 1));
       if (message.find(quantity) != std::string::npos) named += (named.empty() ? "" : " ") + settings[k].shown;
     }
     throw InputError(fmt::format("{}: {}", named.empty() ? all : named, message));

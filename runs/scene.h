@@ -63,10 +63,11 @@ struct TissueScene {
   TissueMaterial material;
   SpgOptions spg;                           // kernel, stabilization, bond failure, cfl (docs/solver.md)
   ContactOptions contact;                   // friction copied from `friction`
-  // The needle's cut, slit, crack and lip (keys in the contact section). A scene crushes the lip below a ground tip
+  // The needle's cut, slit, crack and lip (section tissue.separation: needle_cut, slit, crack, lip; until 2026-11-28
+  // keys of the contact section, still read: runs/scene_key_spellings.h). A scene crushes the lip below a ground tip
   // point by default (since 2026-11-27, docs/notebook/lip_release.md); the solver's own default leaves it off.
   SeparationOptions separation = scene_separation_defaults();
-  CuttingOptions cutting;                   // the cost of cutting on the tip facets (key cutting_pressure_MPa in the contact section)
+  CuttingOptions cutting;                   // the cost of cutting on the tip facets (section tissue.cutting: pressure_MPa)
 };
 
 struct SolverScene {
@@ -91,6 +92,7 @@ struct OutputScene {
 
 struct Scene {
   std::string source;  // the file it came from
+  std::vector<std::string> notes;  // what its reader read but would have the file say otherwise (an older key's spelling)
   NeedleScene needle;
   InsertionProfile motion;
   Eigen::Vector3d direction = Eigen::Vector3d::UnitX();

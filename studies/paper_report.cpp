@@ -17,6 +17,7 @@
 #include "studies/paper_observations.h"
 #include "studies/run_model_description.h"
 #include "runs/scene.h"
+#include "runs/scene_key_spellings.h"
 #include "studies/target_gaps.h"
 #include "geometry/cad_solid.h"
 #include "geometry/grinding_recipe.h"
@@ -45,7 +46,8 @@ struct FittedParameter {
 FittedParameter fitted_parameter(const PaperReportInput& in, const fs::path& dir) {
   if (in.fitted_path.empty() || !fs::is_regular_file(in.fitted_path)) return {};
   const json record = read_json_file(in.fitted_path, "fitted parameter record");
-  const std::string key = record.value("key", std::string()), needle = record.value("fitted_on", std::string());
+  // The key as scenes spell it today (a record of an older study may spell it the older way: runs/scene_key_spellings.h).
+  const std::string key = current_scene_key(record.value("key", std::string())), needle = record.value("fitted_on", std::string());
   const double value = record.value("value", kNaN);
   const fs::path scene_path = dir / "runs" / needle / "scene.json";
   if (key.empty() || needle.empty() || !std::isfinite(value) || !fs::is_regular_file(scene_path)) return {};
@@ -55,7 +57,8 @@ FittedParameter fitted_parameter(const PaperReportInput& in, const fs::path& dir
     pointer += "/" + json_pointer_token(key.substr(start, end - start));
     start = end + 1;
   }
-  const json scene = read_json_file(scene_path.string(), "run scene");
+  // The run's scene as today's effective scene, whatever layout it was stored in.
+  const json scene = scene_to_json(read_run_scene(scene_path.string()));
   const json::json_pointer at(pointer);
   if (!scene.contains(at) || !scene.at(at).is_number() || scene.at(at).get<double>() != value) return {};
   std::string md = fmt::format("## One more parameter fitted to a needle: {}, on {} alone\n\n", record.value("name", key), needle);

@@ -15,9 +15,10 @@
 
 namespace needle {
 
-// Scene keys (in the scene's tissue.contact section, where they have always been): cuts_bonds,
-// slit_half_height_mm, slit_lead_mm, crack_reach_mm, crack_angles_deg, crack_lead_mm, lip_release_depth_mm,
-// lip_release_below_mm.
+// Scene keys: the section tissue.separation mirrors this struct (needle_cut; slit.half_height_mm, slit.lead_mm;
+// crack.reach_mm, crack.angles_deg, crack.lead_mm; lip.mode, lip.below_mm, lip.depth_mm). Until 2026-11-28 scenes wrote
+// them in tissue.contact with a prefix (cuts_bonds, crack_reach_mm, lip_release_mode, ...), still read
+// (runs/scene_key_spellings.h).
 struct SeparationOptions {
   bool needle_cut = true;   // the needle breaks the tissue bonds its body passes through (needle_bond_cut.h);
                             // false: only the tissue's failure criterion separates particles

@@ -11,7 +11,8 @@ SB leaves as the prediction, delta_X ~ -1.14 mm x ratio_X):
 
     /usr/bin/python3 studies/sensitivity/second_parameter.py --key needle.groove_start_mm --values 3,4,5,6 --out gs_loo --jobs 2
 
-A key that is a depth into the lip below tip point A (`--lip-depth`, e.g. tissue.contact.lip_release_depth_mm) acts on a
+A key that is a depth into the lip below tip point A (`--lip-depth`, e.g. tissue.separation.lip.depth_mm;
+its older spelling tissue.contact.lip_release_depth_mm, which the stored records use, is read the same) acts on a
 needle only below that needle's lip thickness: each needle then runs at its own values (`--needle-values HMB=0.2,0.4
 AMB=0.1,0.3`) and once with the key unset (the whole lip), and that run stands for it at every value from its lip
 thickness (the run's summary.json, lip_release.lip_thickness_mm) on; a needle with no values of its own (SB, no lip)

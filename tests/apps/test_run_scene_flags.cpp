@@ -27,8 +27,8 @@ TEST_CASE("needle run --no-needle-cut: the tissue separates by bond failure alon
   };
   const auto [cut_summary, cut_scene] = run_variant("insertion_cut", "");
   const auto [plain_summary, plain_scene] = run_variant("insertion_no_cut", "--no-needle-cut");
-  CHECK(cut_scene["tissue"]["contact"]["cuts_bonds"] == true);
-  CHECK(plain_scene["tissue"]["contact"]["cuts_bonds"] == false);
+  CHECK(cut_scene["tissue"]["separation"]["needle_cut"] == true);
+  CHECK(plain_scene["tissue"]["separation"]["needle_cut"] == false);
   CHECK(cut_summary["bonds_cut_by_needle"].get<long>() > 0);
   CHECK_FALSE(plain_summary.contains("bonds_cut_by_needle"));  // the needle's cut is off: no model, no entry
   CHECK(plain_summary["status"] == "finished");
@@ -134,8 +134,8 @@ TEST_CASE("needle run --slit-half-height-mm: the symmetry plane opens behind the
   // 0.4: four. Once open they may leave the plane, pulled by the tissue beside them.
   const RunFiles closed = run_rod_into_small_block("slit_closed", "");
   const RunFiles open = run_rod_into_small_block("slit_open", "--slit-half-height-mm 0.9");
-  CHECK_FALSE(closed.scene["tissue"]["contact"].contains("slit_half_height_mm"));  // stored scenes stay as they were
-  CHECK(open.scene["tissue"]["contact"]["slit_half_height_mm"].get<double>() == 0.9);
+  CHECK_FALSE(closed.scene["tissue"]["separation"].contains("slit"));  // written only when on
+  CHECK(open.scene["tissue"]["separation"]["slit"]["half_height_mm"].get<double>() == 0.9);
   CHECK_FALSE(closed.summary.contains("slit"));  // a separation model that is off reports nothing
   CHECK(open.summary["slit"]["particles_opened"].get<long>() == 4);
   CHECK(open.summary["slit"]["max_opening_mm"].get<double>() > 0);
@@ -144,7 +144,7 @@ TEST_CASE("needle run --slit-half-height-mm: the symmetry plane opens behind the
   CHECK(open.summary["status"] == "finished");
   CHECK(open.summary["max_energy_balance_error"].get<double>() < 0.05);
 
-  refused_in_one_line("slit_bad", "--slit-half-height-mm -1", "--slit-half-height-mm -1: tissue.contact.slit_half_height_mm must not be negative (got -1)");
+  refused_in_one_line("slit_bad", "--slit-half-height-mm -1", "--slit-half-height-mm -1: tissue.separation.slit.half_height_mm must not be negative (got -1)");
 }
 
 TEST_CASE("needle run --decel-time-ms: a ramped stop leaves the needle far less ringing than an instantaneous one", "[apps][lspg][gmsh][slow]") {
@@ -199,8 +199,8 @@ TEST_CASE("needle run --cutting-pressure-mpa: the scene says so, the tip pays th
   // when on; the work goes into the summary and into the balance (which must still close); the needle is held back harder.
   const RunFiles free_cut = run_sb_into_small_block("cutting_free", "");
   const RunFiles paid_cut = run_sb_into_small_block("cutting_paid", "--cutting-pressure-mpa 0.2");
-  CHECK_FALSE(free_cut.scene["tissue"]["contact"].contains("cutting_pressure_MPa"));
-  CHECK(paid_cut.scene["tissue"]["contact"]["cutting_pressure_MPa"].get<double>() == 0.2);
+  CHECK_FALSE(free_cut.scene["tissue"].contains("cutting"));
+  CHECK(paid_cut.scene["tissue"]["cutting"]["pressure_MPa"].get<double>() == 0.2);
   CHECK_FALSE(free_cut.summary.contains("cutting"));  // no cutting resistance, no entry
   const double work_mJ = paid_cut.summary["cutting"]["work_mJ"].get<double>();
   const double free_drag_N = std::abs(free_cut.history.column("contact_force_x_N").back());
@@ -221,7 +221,7 @@ TEST_CASE("needle run --cutting-pressure-mpa: the scene says so, the tip pays th
   }
 
   // A negative pressure, and a needle without tip facets to load (the plain rod): one line, exit 2, no run folder.
-  for (const auto& [flags, message] : {std::pair<std::string, std::string>{"--cutting-pressure-mpa -1", "--cutting-pressure-mpa -1: tissue.contact.cutting_pressure_MPa must not be negative"},
+  for (const auto& [flags, message] : {std::pair<std::string, std::string>{"--cutting-pressure-mpa -1", "--cutting-pressure-mpa -1: tissue.cutting.pressure_MPa must not be negative"},
                                        {"--cutting-pressure-mpa 0.2", "a cutting pressure needs a needle with tip facets"}}) {
     refused_on_small_block("cutting_bad", flags, message);
   }
@@ -234,9 +234,9 @@ TEST_CASE("needle run --crack-reach-mm: the scene says so, the tip's crack cuts 
   // needle alone cuts none of them. The key is written only when on, and the balance still closes.
   const RunFiles uncracked = run_sb_into_small_block("crack_off", "");
   const RunFiles cracked = run_sb_into_small_block("crack_on", "--crack-reach-mm 1.0 --crack-angles-deg 0");
-  CHECK_FALSE(uncracked.scene["tissue"]["contact"].contains("crack_reach_mm"));
-  CHECK(cracked.scene["tissue"]["contact"]["crack_reach_mm"].get<double>() == 1.0);
-  CHECK(cracked.scene["tissue"]["contact"]["crack_angles_deg"] == nlohmann::json::array({0.0}));
+  CHECK_FALSE(uncracked.scene["tissue"]["separation"].contains("crack"));
+  CHECK(cracked.scene["tissue"]["separation"]["crack"]["reach_mm"].get<double>() == 1.0);
+  CHECK(cracked.scene["tissue"]["separation"]["crack"]["angles_deg"] == nlohmann::json::array({0.0}));
   CHECK_FALSE(uncracked.summary.contains("crack"));  // a separation model that is off reports nothing
   const long crack_cuts = cracked.summary["crack"]["bonds_cut"].get<long>();
   INFO("bonds cut by the crack " << crack_cuts << ", by the needle " << cracked.summary["bonds_cut_by_needle"] << " (without the crack "
@@ -249,18 +249,18 @@ TEST_CASE("needle run --crack-reach-mm: the scene says so, the tip's crack cuts 
 
   // A front 0.4 mm ahead of A splits the gel the tip has not reached yet: the same crack plus the slab ahead of the tip.
   const RunFiles leading = run_sb_into_small_block("crack_lead", "--crack-reach-mm 1.0 --crack-lead-mm 0.4");
-  CHECK(leading.scene["tissue"]["contact"]["crack_lead_mm"].get<double>() == 0.4);
-  CHECK(cracked.scene["tissue"]["contact"]["crack_lead_mm"].get<double>() == 0.0);
+  CHECK(leading.scene["tissue"]["separation"]["crack"]["lead_mm"].get<double>() == 0.4);
+  CHECK(cracked.scene["tissue"]["separation"]["crack"]["lead_mm"].get<double>() == 0.0);
   INFO("bonds cut by the crack with its front 0.4 mm ahead " << leading.summary["crack"]["bonds_cut"]);
   CHECK(leading.summary["crack"]["bonds_cut"].get<long>() > crack_cuts);
   CHECK(leading.summary["status"] == "finished");
 
   // A negative reach or lead, an angle out of range, a crack's shape without a crack, and a needle without a tip point (the
   // plain rod): one line, exit 2, no run folder.
-  for (const auto& [flags, message] : {std::pair<std::string, std::string>{"--crack-reach-mm -1", "--crack-reach-mm -1: tissue.contact.crack_reach_mm must not be negative"},
-                                       {"--crack-reach-mm 1 --crack-lead-mm -0.5", "--crack-lead-mm -0.5: tissue.contact.crack_lead_mm must not be negative"},
-                                       {"--crack-lead-mm 0.5", "--crack-lead-mm 0.5: tissue.contact.crack_lead_mm: the crack's shape (crack_angles_deg, crack_lead_mm) needs a crack: crack_reach_mm above 0"},
-                                       {"--crack-reach-mm 1 --crack-angles-deg 0,200", "--crack-angles-deg 0,200: tissue.contact.crack_angles_deg must lie in [-180, 180] (got 200)"},
+  for (const auto& [flags, message] : {std::pair<std::string, std::string>{"--crack-reach-mm -1", "--crack-reach-mm -1: tissue.separation.crack.reach_mm must not be negative"},
+                                       {"--crack-reach-mm 1 --crack-lead-mm -0.5", "--crack-lead-mm -0.5: tissue.separation.crack.lead_mm must not be negative"},
+                                       {"--crack-lead-mm 0.5", "--crack-lead-mm 0.5: tissue.separation.crack.lead_mm: the crack's shape (its angles and lead) needs a crack: tissue.separation.crack.reach_mm above 0"},
+                                       {"--crack-reach-mm 1 --crack-angles-deg 0,200", "--crack-angles-deg 0,200: tissue.separation.crack.angles_deg must lie in [-180, 180] (got 200)"},
                                        {"--crack-reach-mm 1", "a crack from the tip point needs a needle with a ground tip point"}}) {
     refused_in_one_line("crack_bad", flags, message);
   }
@@ -383,7 +383,7 @@ TEST_CASE("needle run --tissue-entry-x-mm: the block starts there, the rod meets
   }
 }
 
-TEST_CASE("tissue.contact.lip_release_mode: crushed 0.45 mm deep by default, the whole lip, free or off on request, SB has no lip, bad input is refused",
+TEST_CASE("tissue.separation.lip.mode: crushed 0.45 mm deep by default, the whole lip, free or off on request, SB has no lip, bad input is refused",
           "[apps][lspg][gmsh][lip][slow]") {
   // HMB's tip point sits 0.80 mm above the rod's bottom: pushed 0.8 mm into the small block (0.4 mm particles), the particles
   // the tip passes below A inside the rod's outline are crushed by default (bonds kept), cut loose when free (every bond
@@ -391,13 +391,13 @@ TEST_CASE("tissue.contact.lip_release_mode: crushed 0.45 mm deep by default, the
   const std::string hmb = R"("preset": "HMB")";
   const RunFiles off = run_sb_into_small_block("lip_off", "--set tissue.contact.lip_release_mode=off", hmb);
   const RunFiles crushed = run_sb_into_small_block("lip_crushed", "", hmb);
-  const RunFiles whole = run_sb_into_small_block("lip_whole", "--set \"tissue.contact.lip_release_depth_mm=whole lip\"", hmb);
-  const RunFiles free_band = run_sb_into_small_block("lip_free", "--set tissue.contact.lip_release_mode=free --set tissue.contact.lip_release_depth_mm=0.8", hmb);
-  CHECK(off.scene["tissue"]["contact"]["lip_release_mode"] == "off");
-  CHECK(crushed.scene["tissue"]["contact"]["lip_release_mode"] == "crushed");
-  CHECK(crushed.scene["tissue"]["contact"]["lip_release_depth_mm"].get<double>() == needle::kSceneCrushedLipDepthMm);
-  CHECK(whole.scene["tissue"]["contact"]["lip_release_depth_mm"] == "whole lip");
-  CHECK(free_band.scene["tissue"]["contact"]["lip_release_depth_mm"].get<double>() == 0.8);
+  const RunFiles whole = run_sb_into_small_block("lip_whole", "--set \"tissue.separation.lip.depth_mm=whole lip\"", hmb);
+  const RunFiles free_band = run_sb_into_small_block("lip_free", "--set tissue.separation.lip.mode=free --set tissue.separation.lip.depth_mm=0.8", hmb);
+  CHECK(off.scene["tissue"]["separation"]["lip"]["mode"] == "off");  // set in its older spelling (tissue.contact.lip_release_mode)
+  CHECK(crushed.scene["tissue"]["separation"]["lip"]["mode"] == "crushed");
+  CHECK(crushed.scene["tissue"]["separation"]["lip"]["depth_mm"].get<double>() == needle::kSceneCrushedLipDepthMm);
+  CHECK(whole.scene["tissue"]["separation"]["lip"]["depth_mm"] == "whole lip");
+  CHECK(free_band.scene["tissue"]["separation"]["lip"]["depth_mm"].get<double>() == 0.8);
   CHECK_FALSE(off.summary.contains("lip_release"));
   INFO("crushed " << crushed.summary["lip_release"].dump() << "; free " << free_band.summary["lip_release"].dump());
   for (const RunFiles* r : {&crushed, &whole, &free_band}) {
@@ -418,7 +418,7 @@ TEST_CASE("tissue.contact.lip_release_mode: crushed 0.45 mm deep by default, the
         free_band.summary["lip_release"]["bonds_cut"].get<long>() + free_band.summary["bonds_cut_by_needle"].get<long>());
   CHECK(crushed.summary["deflection_mm"].get<double>() != off.summary["deflection_mm"].get<double>());
 
-  const RunFiles sb_off = run_sb_into_small_block("lip_sb_off", "--set tissue.contact.lip_release_mode=off");
+  const RunFiles sb_off = run_sb_into_small_block("lip_sb_off", "--set tissue.separation.lip.mode=off");
   const RunFiles sb_crushed = run_sb_into_small_block("lip_sb_crushed", "");
   CHECK_FALSE(sb_crushed.summary.contains("lip_release"));  // no lip, no model
   CHECK(sb_crushed.summary["deflection_mm"].get<double>() == sb_off.summary["deflection_mm"].get<double>());
@@ -426,10 +426,11 @@ TEST_CASE("tissue.contact.lip_release_mode: crushed 0.45 mm deep by default, the
 
   // A depth that is not positive, a start above A, an unknown mode: one line, exit 2, no run folder.
   for (const auto& [flags, message] :
-       {std::pair<std::string, std::string>{"--set tissue.contact.lip_release_depth_mm=0", "lip_release_depth_mm"},
-        {"--set tissue.contact.lip_release_below_mm=-0.1", "lip_release_below_mm"},
-        {"--set tissue.contact.lip_release_depth_mm=all", "give a depth in mm or \"whole lip\" (got \"all\")"},
-        {"--set tissue.contact.lip_release_mode=dissolved", "must be crushed, free or off (got 'dissolved')"}}) {
+       {std::pair<std::string, std::string>{"--set tissue.separation.lip.depth_mm=0", "--set tissue.separation.lip.depth_mm=0: tissue.separation.lip.depth_mm"},
+        {"--set tissue.separation.lip.below_mm=-0.1", "--set tissue.separation.lip.below_mm=-0.1: tissue.separation.lip.below_mm"},
+        {"--set tissue.contact.lip_release_depth_mm=0", "--set tissue.contact.lip_release_depth_mm=0: tissue.separation.lip.depth_mm"},
+        {"--set tissue.separation.lip.depth_mm=all", "give a depth in mm or \"whole lip\" (got \"all\")"},
+        {"--set tissue.separation.lip.mode=dissolved", "must be crushed, free or off (got 'dissolved')"}}) {
     refused_in_one_line("lip_bad", flags, message);
   }
 }

@@ -72,7 +72,7 @@ TEST_CASE("A --set setting touches only its own key and that key's unit spelling
   const needle::Scene base = needle::parse_scene(
       R"({"tissue": {"enabled": true, "spg": {"stabilization_coefficient": 0.3, "kernel_update_interval_steps": 25},
                      "material": {"relaxing_shear_fraction": 0.5, "relaxation_time_ms": 0.2},
-                     "contact": {"slit_half_height_mm": 0.5, "crack_reach_mm": 1, "cutting_pressure_MPa": 0.1}},
+                     "separation": {"slit": {"half_height_mm": 0.5}, "crack": {"reach_mm": 1}}, "cutting": {"pressure_MPa": 0.1}},
           "solver": {"tissue_mass_scaling": true, "tissue_mass_scaling_dt_ms": 0.003}})",
       "(test)");
   // The longer key's value above, which a default would not give back.

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "runs/scene.h"
+#include "runs/scene_key_spellings.h"
 #include "studies/run_model_description.h"
 
 namespace fs = std::filesystem;
@@ -23,7 +24,7 @@ fs::path scene_file(const std::string& name, const std::string& text) {
 
 }  // namespace
 
-TEST_CASE("A stored run's scene without the keys written since reads as the model before them; a scene file as today's defaults",
+TEST_CASE("A stored run's scene without the keys written since reads as the model before them, a scene file as today's defaults",
           "[scene]") {
   // Before the needle cut and the lip's modes: neither key.
   const fs::path old = scene_file("before_cut", R"({"needle": {"preset": "AMB"}, "tissue": {"enabled": true, "contact": {"skin_mm": 0.02}}})");
@@ -65,4 +66,51 @@ TEST_CASE("Every run scene stored under docs/ reads through read_run_scene, and 
     CHECK(needle::scene_to_json(needle::read_run_scene(again.string())) == effective);
   }
   CHECK(scenes > 100);  // the sensitivity studies' cases and the stored benches
+}
+
+TEST_CASE("The separation's and cutting's keys in their older spelling (tissue.contact.crack_reach_mm) read as their sections' keys, with a note",
+          "[scene]") {
+  const Scene today = needle::parse_scene(
+      R"({"tissue": {"separation": {"needle_cut": false, "slit": {"half_height_mm": 0.5, "lead_mm": 0.1},
+                                    "crack": {"reach_mm": 1, "angles_deg": [0, -45], "lead": "0.2 mm"},
+                                    "lip": {"mode": "free", "below_mm": 0.1, "depth_mm": 0.3}},
+                     "cutting": {"pressure_MPa": 0.1}}})",
+      "today.json");
+  const Scene older = needle::parse_scene(
+      R"({"tissue": {"contact": {"cuts_bonds": false, "slit_half_height_mm": 0.5, "slit_lead_mm": 0.1,
+                                 "crack_reach_mm": 1, "crack_angles_deg": [0, -45], "crack_lead": "0.2 mm",
+                                 "lip_release_mode": "free", "lip_release_below_mm": 0.1, "lip_release_depth_mm": 0.3,
+                                 "cutting_pressure_MPa": 0.1}}})",
+      "older.json");
+  CHECK(needle::scene_to_json(older) == needle::scene_to_json(today));
+  CHECK(today.notes.empty());
+  REQUIRE(older.notes.size() == 10);  // one a key, each naming the file, the line and where the key lives now
+  CHECK(older.notes[0].rfind("older.json:", 0) == 0);
+  bool crack_note = false;
+  for (const std::string& note : older.notes)
+    crack_note |= note.find("tissue.contact.crack_reach_mm is read as tissue.separation.crack.reach_mm") != std::string::npos;
+  CHECK(crack_note);
+  CHECK_FALSE(today.tissue.separation.needle_cut);
+  CHECK(today.tissue.separation.crack.lead_mm == Approx(0.2));
+  CHECK(today.tissue.cutting.pressure_MPa == 0.1);
+
+  // Both spellings of one key: refused, naming both.
+  CHECK_THROWS_WITH(needle::parse_scene(R"({"tissue": {"contact": {"crack_reach": "1 mm"}, "separation": {"crack": {"reach_mm": 2}}}})", "both.json"),
+                    Catch::Contains("tissue.separation.crack.reach_mm or tissue.contact.crack_reach (its older spelling), not both"));
+  // The checks read where the key is given: a slit needs a half model, a crack's shape a crack.
+  CHECK_THROWS_WITH(needle::parse_scene(R"({"needle": {"half_model": false}, "tissue": {"contact": {"slit_half_height_mm": 0.5}}})", "full.json"),
+                    Catch::Contains("tissue.contact.slit_half_height_mm: the slit opens the symmetry plane"));
+  CHECK_THROWS_WITH(needle::parse_scene(R"({"tissue": {"separation": {"crack": {"lead_mm": 0.5}}}})", "shape.json"),
+                    Catch::Contains("tissue.separation.crack.lead_mm: the crack's shape (its angles and lead) needs a crack"));
+
+  // --set in the older spelling sets today's key (and replaces its value), with a note naming the setting.
+  const Scene set = needle::apply_scene_settings(today, {"tissue.contact.crack_reach_mm=1.5", "tissue.contact.cuts_bonds=true"});
+  CHECK(set.tissue.separation.crack.reach_mm == 1.5);
+  CHECK(set.tissue.separation.needle_cut);
+  REQUIRE(set.notes.size() == 2);
+  CHECK(set.notes[0] == "--set tissue.contact.crack_reach_mm=1.5: tissue.contact.crack_reach_mm is read as tissue.separation.crack.reach_mm "
+                        "(its place since 2026-11-28; docs/scenes.md)");
+  CHECK(needle::current_scene_key("tissue.contact.lip_release_depth") == "tissue.separation.lip.depth");
+  CHECK(needle::current_scene_key("tissue.contact.skin_mm") == "tissue.contact.skin_mm");
+  CHECK(needle::current_scene_key("tissue.contact.crack_angles_deg") == "tissue.separation.crack.angles_deg");
 }
