@@ -87,7 +87,7 @@ void bench_insertion(const BenchOptions& o) {
   write_speed_error_report(results, o.out_dir, reference_source);
   if (!o.quiet) {
     fmt::print("\n{}", speed_error_table(results));
-    fmt::print("reference: {}\nwritten: {}/speed_error.csv, speed_error.json, speed_error.png\n", reference_source, o.out_dir);
+    fmt::print("reference: {}\nwritten: {}/speed_error.csv, speed_error.json, speed_error.png, speed_error.md\n", reference_source, o.out_dir);
   }
 }
 

@@ -1,5 +1,6 @@
 #include "core/parallel.h"
 
+#include <algorithm>
 #include <memory>
 #include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
@@ -46,5 +47,10 @@ ThreadLimit::ThreadLimit(int threads) : impl_(new Impl) {
 ThreadLimit::~ThreadLimit() { delete impl_; }
 
 int hardware_threads() { return tbb::info::default_concurrency(); }
+
+int allowed_threads() {
+  return static_cast<int>(std::min<size_t>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism),
+                                           static_cast<size_t>(hardware_threads())));
+}
 
 }  // namespace needle

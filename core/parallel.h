@@ -61,5 +61,7 @@ class ThreadLimit {
 };
 
 int hardware_threads();
+// The worker threads parallel_for may use now: hardware_threads(), or fewer under a ThreadLimit.
+int allowed_threads();
 
 }  // namespace needle

@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include "core/interrupt.h"
+#include "core/machine_load.h"
 #include "core/parallel.h"
 #include "core/solver_error.h"
 #include "runs/provenance_json.h"
@@ -15,6 +16,7 @@ void drive_run(const Scene& scene, const RunOptions& o, const std::function<std:
   using Clock = std::chrono::steady_clock;
   const ThreadLimit threads(o.threads >= 0 ? o.threads : scene.solver.threads);
   const auto start = Clock::now();
+  const MachineLoad load_at_start = machine_load();  // what ran beside the run, for its timings
   const InterruptWatch interrupts;  // Ctrl-C or SIGTERM: stop between steps and write what there is
   RunFolder::check_target(o.out_dir, o.overwrite);  // a bad --out is refused before the seconds of setup
   const std::unique_ptr<RunModel> built = build();
@@ -92,6 +94,13 @@ void drive_run(const Scene& scene, const RunOptions& o, const std::function<std:
       {"threads", hardware_threads()},
       {"provenance", provenance_json()},
   };
+  // The run's timings with what ran beside them: the threads it used of the machine's cores, and the machine's 1-minute
+  // load average as it started and as it ended (the run's own threads count in the second).
+  const MachineLoad load_at_end = machine_load();
+  summary["machine"] = {{"cores", load_at_end.cores},
+                        {"threads_used", allowed_threads()},
+                        {"load_average_1min_at_start", load_at_start.load_average_1min >= 0 ? nlohmann::json(load_at_start.load_average_1min) : nlohmann::json()},
+                        {"load_average_1min_at_end", load_at_end.load_average_1min >= 0 ? nlohmann::json(load_at_end.load_average_1min) : nlohmann::json()}};
   model.add_summary(summary, solve_s);
   {
     std::ofstream out(folder.path("summary.json"));

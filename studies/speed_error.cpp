@@ -44,7 +44,37 @@ SpeedErrorCase speed_error_case(const std::string& needle, const std::string& le
   c.needle_steps = s.value("needle_steps", 0L);
   c.max_particles_inside = s.value("max_particles_inside", 0);
   c.error_vs_reference_mm = c.error_vs_full_mm = kNaN;
+  const nlohmann::json machine = s.value("machine", nlohmann::json::object());
+  c.threads_used = machine.value("threads_used", 0);
+  c.cores = machine.value("cores", 0);
+  const auto load = [&machine](const char* key) { return machine.contains(key) && machine[key].is_number() ? machine[key].get<double>() : kNaN; };
+  c.load_at_start = load("load_average_1min_at_start");
+  c.load_at_end = load("load_average_1min_at_end");
   return c;
+}
+
+std::string beside_words(const SpeedErrorCase& c) {
+  if (c.threads_used <= 0) return "not recorded";
+  std::string words = fmt::format("{} thread{} of {} cores", c.threads_used, c.threads_used == 1 ? "" : "s", c.cores);
+  if (std::isfinite(c.load_at_start) && std::isfinite(c.load_at_end))
+    words += fmt::format(", load {:.1f} at the start, {:.1f} at the end", c.load_at_start, c.load_at_end);
+  return words;
+}
+
+std::string speed_error_markdown(const std::vector<SpeedErrorCase>& cases, const std::string& reference_source) {
+  const auto mm = [](double v) { return std::isfinite(v) ? fmt::format("{:+.4f}", v) : std::string("–"); };
+  std::string md = fmt::format(
+      "Each needle at each model level on the same scene; δ's error against the converged reference ({}) and against the "
+      "full level's run. The load is the machine's 1-minute load average (the run's own threads count in it at the end: "
+      "more than the threads used means other work ran beside).\n\n",
+      reference_source);
+  md += "| needle | level | δ (mm) | vs reference | vs full | coupling steps | needle steps | time (s) | beside it |\n";
+  md += "|---|---|---|---|---|---|---|---|---|\n";
+  for (const SpeedErrorCase& c : cases)
+    md += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {:.1f} | {} |\n", c.needle, c.level,
+                      c.status == "finished" ? fmt::format("{:+.4f}", c.deflection_mm) : c.status, mm(c.error_vs_reference_mm),
+                      mm(c.error_vs_full_mm), c.coupling_steps, c.needle_steps, c.runtime_s, beside_words(c));
+  return md;
 }
 
 void fill_errors(std::vector<SpeedErrorCase>& cases, const nlohmann::json& reference_mm) {
@@ -60,13 +90,13 @@ void fill_errors(std::vector<SpeedErrorCase>& cases, const nlohmann::json& refer
 
 std::string speed_error_table(const std::vector<SpeedErrorCase>& cases) {
   std::string out = fmt::format("{:<7} {:<11} {:>9} {:>9} {:>10} {:>11} {:>12} {:>11} {:>10} {:>9}  {}\n", "needle", "level", "time_s",
-                                "steps", "needle_st", "delta_mm", "err_ref_mm", "err_full_mm", "depth_mm", "energy_%", "status");
+                                "steps", "needle_st", "delta_mm", "err_ref_mm", "err_full_mm", "depth_mm", "energy_%", "status (beside it)");
   for (const SpeedErrorCase& c : cases)
-    out += fmt::format("{:<7} {:<11} {:>9.1f} {:>9} {:>10} {:>11.4f} {:>12} {:>11} {:>10.3g} {:>9.3f}  {}{}\n", c.needle, c.level, c.runtime_s,
+    out += fmt::format("{:<7} {:<11} {:>9.1f} {:>9} {:>10} {:>11.4f} {:>12} {:>11} {:>10.3g} {:>9.3f}  {}{} ({})\n", c.needle, c.level, c.runtime_s,
                        c.coupling_steps, c.needle_steps, c.deflection_mm,
                        std::isfinite(c.error_vs_reference_mm) ? fmt::format("{:+.4f}", c.error_vs_reference_mm) : "-",
                        std::isfinite(c.error_vs_full_mm) ? fmt::format("{:+.4f}", c.error_vs_full_mm) : "-", c.max_penetration_mm,
-                       100 * c.max_energy_balance_error, c.status, c.reason.empty() ? "" : ": " + c.reason);
+                       100 * c.max_energy_balance_error, c.status, c.reason.empty() ? "" : ": " + c.reason, beside_words(c));
   return out;
 }
 
@@ -75,12 +105,12 @@ void write_speed_error_report(const std::vector<SpeedErrorCase>& cases, const st
   write_file_atomically((dir / "speed_error.csv").string(), [&](const std::string& scratch) {
     std::ofstream f(scratch);
     f << "needle,level,runtime_s,coupling_steps,needle_steps,deflection_mm,error_vs_reference_mm,error_vs_full_mm,max_penetration_mm,"
-         "max_particles_inside,max_energy_balance_error,status,reason\n";
+         "max_particles_inside,max_energy_balance_error,status,reason,threads_used,cores,load_average_1min_at_start,load_average_1min_at_end\n";
     for (const SpeedErrorCase& c : cases)
-      f << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{}\n", c.needle, c.level, csv_number(c.runtime_s), c.coupling_steps,
+      f << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", c.needle, c.level, csv_number(c.runtime_s), c.coupling_steps,
                        c.needle_steps, csv_number(c.deflection_mm), csv_number(c.error_vs_reference_mm), csv_number(c.error_vs_full_mm),
                        csv_number(c.max_penetration_mm), c.max_particles_inside, csv_number(c.max_energy_balance_error), c.status,
-                       csv_text(c.reason));
+                       csv_text(c.reason), c.threads_used, c.cores, csv_number(c.load_at_start), csv_number(c.load_at_end));
   });
   nlohmann::json j = {{"reference", reference_source}, {"cases", nlohmann::json::array()}};
   for (const SpeedErrorCase& c : cases)
@@ -88,8 +118,11 @@ void write_speed_error_report(const std::vector<SpeedErrorCase>& cases, const st
                           {"needle_steps", c.needle_steps}, {"deflection_mm", json_number(c.deflection_mm)},
                           {"error_vs_reference_mm", json_number(c.error_vs_reference_mm)}, {"error_vs_full_mm", json_number(c.error_vs_full_mm)},
                           {"max_penetration_mm", json_number(c.max_penetration_mm)}, {"max_particles_inside", c.max_particles_inside},
-                          {"max_energy_balance_error", json_number(c.max_energy_balance_error)}, {"status", c.status}, {"reason", c.reason}});
+                          {"max_energy_balance_error", json_number(c.max_energy_balance_error)}, {"status", c.status}, {"reason", c.reason},
+                          {"threads_used", c.threads_used}, {"cores", c.cores}, {"load_average_1min_at_start", json_number(c.load_at_start)},
+                          {"load_average_1min_at_end", json_number(c.load_at_end)}});
   write_file_atomically((dir / "speed_error.json").string(), [&](const std::string& scratch) { std::ofstream(scratch) << j.dump(2) << "\n"; });
+  write_file_atomically((dir / "speed_error.md").string(), [&](const std::string& scratch) { std::ofstream(scratch) << speed_error_markdown(cases, reference_source); });
   // Time against |error vs the reference|, one series of points per needle (levels in the order run).
   LinePlot plot;
   plot.title = "Speed against error: each model level (time, |deflection - reference|)";

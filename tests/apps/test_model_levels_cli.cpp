@@ -86,7 +86,7 @@ TEST_CASE("needle bench insertion writes one row per needle and level from the r
                             R"("tissue": {"enabled": true, "size_mm": [2, 2.4, 1.2], "spacing_mm": 0.4}, "output": {"frames": 0}})");
   write(dir / "reference.json", R"({"travel_mm": 0.8, "deflection_mm": {"SB": -0.001}})");
   const std::string args = "bench insertion --scene " + (dir / "scene.json").string() + " --reference " + (dir / "reference.json").string() +
-                           " --needles SB --levels projection,fast --out " + (dir / "out").string();
+                           " --needles SB --levels projection,fast --threads 1 --out " + (dir / "out").string();
   const Result r = run(args, true);
   INFO(r.out);
   REQUIRE(r.exit_code == 0);
@@ -100,9 +100,27 @@ TEST_CASE("needle bench insertion writes one row per needle and level from the r
     CHECK(table.column("deflection_mm")[static_cast<size_t>(k)] == Approx(summary["deflection_mm"].get<double>()).epsilon(1e-12));
     CHECK(table.column("error_vs_reference_mm")[static_cast<size_t>(k)] == Approx(summary["deflection_mm"].get<double>() + 0.001).epsilon(1e-9));
     CHECK(table.column("coupling_steps")[static_cast<size_t>(k)] == summary["steps"].get<double>());
+    // What ran beside it: the one thread asked for, of the machine's cores, and the machine's load average (what
+    // /proc/loadavg said at the run's start and end: a number where Linux gives it).
+    const nlohmann::json& machine = summary["machine"];
+    CHECK(machine["threads_used"] == 1);
+    CHECK(machine["cores"].get<int>() >= 1);
+    CHECK(table.column("threads_used")[static_cast<size_t>(k)] == 1);
+    CHECK(table.column("cores")[static_cast<size_t>(k)] == machine["cores"].get<double>());
+    if (fs::exists("/proc/loadavg")) {
+      CHECK(machine["load_average_1min_at_start"].get<double>() >= 0);
+      CHECK(table.column("load_average_1min_at_end")[static_cast<size_t>(k)] == Approx(machine["load_average_1min_at_end"].get<double>()));
+    }
   }
   CHECK(fs::exists(dir / "out" / "speed_error.png"));
   CHECK(fs::exists(dir / "out" / "speed_error.json"));
+  // The Markdown table docs/insertion.md shows: a row a case, with what ran beside it.
+  std::ifstream md_file(dir / "out" / "speed_error.md");
+  const std::string md((std::istreambuf_iterator<char>(md_file)), std::istreambuf_iterator<char>());
+  CHECK(md.find("| SB | projection | ") != std::string::npos);
+  CHECK(md.find("| SB | fast | ") != std::string::npos);
+  CHECK(md.find("1 thread of ") != std::string::npos);
+  CHECK(md.find((dir / "reference.json").string()) != std::string::npos);
   // Again: both runs are reused, the table is the same.
   const Result again = run(args, true);
   CHECK(again.exit_code == 0);
