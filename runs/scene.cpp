@@ -120,34 +120,35 @@ void read_cannula(SceneObject o, CannulaOptions& c) {
   o.finish();
 }
 
-// One separation model's keys ("slit", "crack" or "lip"), each named prefix + its name: in its own section (no prefix)
-// or in the contact section as scenes wrote them until 2026-11-28 ("crack_", "lip_release_").
-void read_separation_model(SceneObject& o, const std::string& model, const std::string& prefix, SeparationOptions& s) {
-  const std::string p = prefix;
-  if (model == "slit") {
-    s.slit.half_height_mm = o.quantity(p + "half_height", Dimension::length, s.slit.half_height_mm, non_negative());
-    s.slit.lead_mm = o.quantity(p + "lead", Dimension::length, s.slit.lead_mm, non_negative());
-  } else if (model == "crack") {
-    s.crack.reach_mm = o.quantity(p + "reach", Dimension::length, s.crack.reach_mm, non_negative());
-    s.crack.angles_deg = o.numbers(p + "angles_deg", s.crack.angles_deg, within(-180.0, 180.0));
-    s.crack.lead_mm = o.quantity(p + "lead", Dimension::length, s.crack.lead_mm, non_negative());
+// The separation models' keys, each named prefix + its name: in its own section (no prefix) or in the contact section as
+// scenes wrote them until 2026-11-28 ("slit_", "crack_", "lip_release_").
+void read_slit(SceneObject& o, const std::string& prefix, SymmetrySlitOptions& slit) {
+  slit.half_height_mm = o.quantity(prefix + "half_height", Dimension::length, slit.half_height_mm, non_negative());
+  slit.lead_mm = o.quantity(prefix + "lead", Dimension::length, slit.lead_mm, non_negative());
+}
+
+void read_crack(SceneObject& o, const std::string& prefix, TipCrackOptions& crack) {
+  crack.reach_mm = o.quantity(prefix + "reach", Dimension::length, crack.reach_mm, non_negative());
+  crack.angles_deg = o.numbers(prefix + "angles_deg", crack.angles_deg, within(-180.0, 180.0));
+  crack.lead_mm = o.quantity(prefix + "lead", Dimension::length, crack.lead_mm, non_negative());
+}
+
+void read_lip(SceneObject& o, const std::string& prefix, LipReleaseOptions& lip) {
+  // The band's depth: a length, or "whole lip" (down to the rod's bottom, however thick the lip).
+  const std::string depth_key = prefix + "depth_mm";
+  if (o.has(depth_key) && o.raw(depth_key).is_string()) {
+    const std::string depth = o.raw(depth_key).get<std::string>();
+    NEEDLE_REQUIRE(depth == kWholeLipText, fmt::format("{}: give a depth in mm or \"{}\" (got \"{}\")", o.where(depth_key), kWholeLipText, depth));
+    lip.depth_mm = std::numeric_limits<double>::infinity();
   } else {
-    // The band's depth: a length, or "whole lip" (down to the rod's bottom, however thick the lip).
-    const std::string depth_key = p + "depth_mm";
-    if (o.has(depth_key) && o.raw(depth_key).is_string()) {
-      const std::string depth = o.raw(depth_key).get<std::string>();
-      NEEDLE_REQUIRE(depth == kWholeLipText, fmt::format("{}: give a depth in mm or \"{}\" (got \"{}\")", o.where(depth_key), kWholeLipText, depth));
-      s.lip.depth_mm = std::numeric_limits<double>::infinity();
-    } else {
-      s.lip.depth_mm = o.quantity(p + "depth", Dimension::length, s.lip.depth_mm, positive());
-    }
-    s.lip.below_mm = o.quantity(p + "below", Dimension::length, s.lip.below_mm, non_negative());
-    const std::string mode = o.text(p + "mode", lip_release_mode_name(s.lip.mode));
-    try {
-      s.lip.mode = lip_release_mode_from_name(mode);
-    } catch (const InputError& e) {
-      throw InputError(fmt::format("{}: {}", o.where(p + "mode"), e.what()));
-    }
+    lip.depth_mm = o.quantity(prefix + "depth", Dimension::length, lip.depth_mm, positive());
+  }
+  lip.below_mm = o.quantity(prefix + "below", Dimension::length, lip.below_mm, non_negative());
+  const std::string mode = o.text(prefix + "mode", lip_release_mode_name(lip.mode));
+  try {
+    lip.mode = lip_release_mode_from_name(mode);
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("{}: {}", o.where(prefix + "mode"), e.what()));
   }
 }
 
@@ -185,9 +186,9 @@ void read_older_contact_keys(SceneObject& c, const JsonDocument& doc, TissueScen
     notes.push_back(older_spelling_note(doc.where("/tissue/contact/" + json_pointer_token(item.key())), item.key(), *now));
   }
   t.separation.needle_cut = c.boolean("cuts_bonds", t.separation.needle_cut);
-  read_separation_model(c, "slit", "slit_", t.separation);
-  read_separation_model(c, "crack", "crack_", t.separation);
-  read_separation_model(c, "lip", "lip_release_", t.separation);
+  read_slit(c, "slit_", t.separation.slit);
+  read_crack(c, "crack_", t.separation.crack);
+  read_lip(c, "lip_release_", t.separation.lip);
   read_cutting(c, "cutting_", t.cutting);
 }
 
@@ -257,12 +258,15 @@ void read_tissue(SceneObject o, TissueScene& t, const JsonDocument& doc, std::ve
   if (o.has("separation")) {
     SceneObject sep = o.child("separation");
     t.separation.needle_cut = sep.boolean("needle_cut", t.separation.needle_cut);
-    for (const char* model : {"slit", "crack", "lip"}) {
-      if (!sep.has(model)) continue;
-      SceneObject m = sep.child(model);
-      read_separation_model(m, model, "", t.separation);
+    const auto section = [&sep](const char* name, const auto& read) {
+      if (!sep.has(name)) return;
+      SceneObject m = sep.child(name);
+      read(m);
       m.finish();
-    }
+    };
+    section("slit", [&t](SceneObject& m) { read_slit(m, "", t.separation.slit); });
+    section("crack", [&t](SceneObject& m) { read_crack(m, "", t.separation.crack); });
+    section("lip", [&t](SceneObject& m) { read_lip(m, "", t.separation.lip); });
     sep.finish();
   }
   if (o.has("cutting")) {
