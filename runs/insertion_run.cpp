@@ -1,5 +1,6 @@
 #include "runs/insertion_run.h"
 
+#include <algorithm>
 #include <chrono>
 #include <fmt/format.h>
 #include <fstream>
@@ -125,6 +126,10 @@ class InsertionRunModel : public RunModel {
     const InsertionEnergy& e = run_->energy();
     const GrooveFill groove = run_groove_fill(*run_, built_, scene_);
     summary["needle_steps"] = run_->needle_steps();
+    // How many coupling steps each limit set (solver/insertion/coupled_insertion.h: StepLimit).
+    json limits = json::object();
+    for (int k = 0; k < kStepLimits; ++k) limits[step_limit_name(static_cast<StepLimit>(k))] = run_->step_limits()[static_cast<size_t>(k)];
+    summary["coupling_step_limits"] = limits;
     summary["needle_model"] = needle_model_->name();
     summary["contact_law"] = run_->contact_model().law();
     summary["model_level"] = model_level_of(scene_);
@@ -174,9 +179,19 @@ class InsertionRunModel : public RunModel {
   }
   std::string log_steps(double solve_s) const override {
     return fmt::format("{} coupling steps and {} needle steps in {:.2f} s, energy balance error {:.3g}, max penetration {:.3g} mm, {} particles "
-                       "inside at the end",
+                       "inside at the end; the coupling step set by {}",
                        run_->steps(), run_->needle_steps(), solve_s, run_->energy().balance_error(), run_->max_depth_mm(),
-                       run_->contact().particles_inside);
+                       run_->contact().particles_inside, step_limits_words());
+  }
+  // "tissue 1446 times, interval_end once": what set the coupling steps (StepLimit), most first.
+  std::string step_limits_words() const {
+    std::vector<std::pair<long, std::string>> counts;
+    for (int k = 0; k < kStepLimits; ++k)
+      if (const long n = run_->step_limits()[static_cast<size_t>(k)]; n > 0) counts.emplace_back(n, step_limit_name(static_cast<StepLimit>(k)));
+    std::sort(counts.begin(), counts.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+    std::string words;
+    for (const auto& [n, name] : counts) words += fmt::format("{}{} {}", words.empty() ? "" : ", ", name, n == 1 ? "once" : fmt::format("{} times", n));
+    return words.empty() ? "nothing (no step)" : words;
   }
   std::string print_steps() const override { return fmt::format("{} steps ({} needle steps)", run_->steps(), run_->needle_steps()); }
 

@@ -56,7 +56,9 @@ CoupledInsertion::CoupledInsertion(NeedleModel& needle, SpgTissue& tissue, const
 void CoupledInsertion::step(double end_time_ms) {
   const double t = time_ms();
   if (tissue_dynamics_.at_rate_cycle_start() && options_.tissue_rate_needle_margin_mm >= 0) hold_particles_near_needle_fast();
-  const double dt = tissue_dynamics_.kick_and_drift(plan_time_step(end_time_ms));
+  StepLimit limit = StepLimit::tissue;
+  const double dt = tissue_dynamics_.kick_and_drift(plan_time_step(end_time_ms, limit));
+  ++step_limits_[static_cast<size_t>(limit)];
   contact_->begin_step(tissue_.particles(), needle_.positions_mm(), needle_.velocities_mm_per_ms(), t, dt);
   if (options_.tissue_beside_needle) {
     mark_particles_away_from_needle();
@@ -112,15 +114,34 @@ void CoupledInsertion::hold_particles_near_needle_fast() {
   tissue_dynamics_.set_fast_particles(std::move(fast));
 }
 
-double CoupledInsertion::plan_time_step(double end_time_ms) const {
+const char* step_limit_name(StepLimit limit) {
+  switch (limit) {
+    case StepLimit::interval_end: return "interval_end";
+    case StepLimit::max_step: return "max_step";
+    case StepLimit::contact: return "contact";
+    case StepLimit::needle_step: return "needle_step";
+    case StepLimit::tissue: return "tissue";
+  }
+  return "unknown";
+}
+
+double CoupledInsertion::plan_time_step(double end_time_ms, StepLimit& limit) const {
   const double t = time_ms();
   double cap = end_time_ms - t;
   NEEDLE_REQUIRE(cap > 0, "the insertion has reached its end time");
-  if (options_.max_step_ms > 0) cap = std::min(cap, options_.max_step_ms);
-  cap = std::min(cap, contact_->max_time_step_ms(options_.contact_courant));
+  limit = StepLimit::interval_end;
+  const auto lower = [&cap, &limit](double bound, StepLimit why) {
+    if (bound < cap) {
+      cap = bound;
+      limit = why;
+    }
+  };
+  if (options_.max_step_ms > 0) lower(options_.max_step_ms, StepLimit::max_step);
+  lower(contact_->max_time_step_ms(options_.contact_courant), StepLimit::contact);
   const double needle_dt = needle_.time_step_ms(), grid = needle_.step_grid_ms();
-  if (!options_.subcycling) cap = std::min(cap, needle_dt);
+  if (!options_.subcycling) lower(needle_dt, StepLimit::needle_step);
   double dt = tissue_dynamics_.time_step_ms(cap);
+  if (dt < cap) limit = StepLimit::tissue;
   // A whole number of the needle's grid per coupling step, so that the needle never takes a sliver of a step
   // (below one grid step: its half, quarter ...).
   if (std::isfinite(grid) && dt < end_time_ms - t) {

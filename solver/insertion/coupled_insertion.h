@@ -23,6 +23,7 @@
 // The run stops with a SolverError (never NaN) on non-finite state, runaway penetration, time-step collapse
 // or energy drift (insertion_energy.h).
 #include <Eigen/Dense>
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -62,6 +63,14 @@ struct CouplingOptions {
   void validate(const std::string& where = "coupling") const;
 };
 
+// What set a coupling step (issue 48: whatever limits the step is named): the end of the interval it lands on, the
+// scene's max_coupling_step, the penalty contact's stable step, the needle's own step (without subcycling), or the
+// tissue's stable step (mass-scaled, and within a cycle of the rate levels its base step). The step is then rounded
+// down to a whole number of the needle's grid (a rounding, not a limit).
+enum class StepLimit { interval_end, max_step, contact, needle_step, tissue };
+constexpr int kStepLimits = 5;
+const char* step_limit_name(StepLimit limit);  // "interval_end", ...
+
 class CoupledInsertion {
  public:
   // The needle, the tissue and the surface are advanced or read by this object; they must outlive it.
@@ -76,6 +85,8 @@ class CoupledInsertion {
   double time_ms() const { return tissue_dynamics_.time_ms(); }
   long steps() const { return steps_; }
   double last_step_ms() const { return last_dt_ms_; }
+  // How many coupling steps each limit set, by StepLimit.
+  const std::array<long, kStepLimits>& step_limits() const { return step_limits_; }
   long needle_steps() const { return needle_.steps(); }
   // The loads on the needle at the last evaluation: the contact's, with the cutting resistance's added in.
   ContactReport contact() const;
@@ -96,7 +107,7 @@ class CoupledInsertion {
   const TissueDynamics& tissue_dynamics() const { return tissue_dynamics_; }
 
  private:
-  double plan_time_step(double end_time_ms) const;
+  double plan_time_step(double end_time_ms, StepLimit& limit) const;
   // One flag per particle: whether it lies inside (inside true) or outside the needle's box (with a half model's
   // mirror image) widened by margin_mm.
   void flag_particles_by_needle_box(double margin_mm, bool inside, std::vector<std::uint8_t>& flags) const;
@@ -127,6 +138,7 @@ class CoupledInsertion {
   double last_dt_ms_ = 0, max_energy_error_ = 0, max_depth_ = 0;
   int max_inside_ = 0;
   long steps_ = 0;
+  std::array<long, kStepLimits> step_limits_{};
 };
 
 }  // namespace needle

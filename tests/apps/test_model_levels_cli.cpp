@@ -53,6 +53,23 @@ TEST_CASE("needle run --model fast runs the implicit needle with the kinematic c
   CHECK(full.summary["model_level"] == "full");
   CHECK(full.summary["needle_steps"].get<long>() > 20 * full.summary["steps"].get<long>());
   CHECK(full.summary["steps"].get<long>() > 2 * fast.summary["steps"].get<long>());
+  // What set each coupling step (issue 48): every step counted once; the full level's penalty contact sets most of its
+  // steps (its stiffness caps the step), the fast level's kinematic contact none (the tissue's mass-scaled step does).
+  const auto limits_sum = [](const nlohmann::json& limits) {
+    long sum = 0;
+    for (const auto& [name, count] : limits.items()) sum += count.get<long>();
+    return sum;
+  };
+  for (const RunFiles* r : {&fast, &full, &unscaled}) {
+    INFO(r->summary["coupling_step_limits"].dump());
+    CHECK(limits_sum(r->summary["coupling_step_limits"]) == r->summary["steps"].get<long>());
+  }
+  CHECK(2 * full.summary["coupling_step_limits"]["contact"].get<long>() > full.summary["steps"].get<long>());
+  CHECK(fast.summary["coupling_step_limits"]["contact"] == 0);
+  CHECK(2 * fast.summary["coupling_step_limits"]["tissue"].get<long>() > fast.summary["steps"].get<long>());
+  std::ifstream log_file(fs::temp_directory_path() / "needle_sim_model_fast" / "run" / "run.log");  // run_sb_into_small_block's folder
+  const std::string log((std::istreambuf_iterator<char>(log_file)), std::istreambuf_iterator<char>());
+  CHECK(log.find("the coupling step set by tissue ") != std::string::npos);
   refused_on_small_block("model_bad", "--model quick", "--model: unknown model level 'quick' (known: full, projection, fast)");
   refused_on_small_block("model_mixed", "--set needle.model=implicit", "needle.model implicit needs tissue.contact.law projection");
   refused_on_small_block("model_law", "--set tissue.contact.law=spring", "law: must be penalty or projection (got 'spring')");
