@@ -222,8 +222,8 @@ void run_insertion(const Scene& scene, const RunOptions& o) {
 
 bool folder_holds_run_of(const Scene& scene, const std::string& folder_name) {
   const std::filesystem::path folder(folder_name);
-  std::ifstream summary(folder / "summary.json"), stored(folder / "scene.json");
-  if (!summary.good() || !stored.good()) return false;
+  std::ifstream summary(folder / "summary.json");
+  if (!summary.good() || !std::filesystem::is_regular_file(folder / "scene.json")) return false;
   // The worker threads are left out of the comparison: every kernel is a gather (core/parallel.h), so a run's
   // results do not depend on them (a test runs the same scene on one and two threads and compares the histories).
   auto without_threads = [](json scene_json) {
@@ -235,8 +235,7 @@ bool folder_holds_run_of(const Scene& scene, const std::string& folder_name) {
     if (json::parse(summary).value("status", std::string()) == "interrupted") return false;
     // The stored scene read as a run's (runs/scene.h: an older layout or older keys read as what they meant), written
     // again as today's effective scene, against this scene's.
-    return without_threads(json::parse(scene_to_json(read_run_scene((folder / "scene.json").string())).dump())) ==
-           without_threads(json::parse(scene_to_json(scene).dump()));
+    return without_threads(scene_to_json(read_run_scene((folder / "scene.json").string()))) == without_threads(scene_to_json(scene));
   } catch (const json::exception&) {
     return false;  // an unreadable folder holds no run
   } catch (const InputError&) {

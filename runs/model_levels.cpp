@@ -1,6 +1,7 @@
 #include "runs/model_levels.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <string>
 #include <vector>
 
@@ -70,8 +71,7 @@ std::string describe_model_choices(const Scene& scene) {
   if (mass_scaled) choices.emplace_back("the tissue selectively mass-scaled");
   if (ellipsoids) choices.emplace_back("ellipsoidal kernel supports");
   if (!multirate.empty()) choices.push_back(multirate);
-  std::string listed;
-  for (const std::string& c : choices) listed += (listed.empty() ? "" : ", ") + c;
+  const std::string listed = fmt::format("{}", fmt::join(choices, ", "));
   if (law == full.contact_law && !needle_entry.takes_coupling_step) return listed;
   std::string level_flag;  // the level these keys make, if any but the full one
   for (const ModelLevel& level : model_levels())

@@ -183,7 +183,8 @@ void read_older_contact_keys(SceneObject& c, const JsonDocument& doc, TissueScen
         NEEDLE_REQUIRE(key_quantity(given.key()) != now->quantity,
                        fmt::format("{}: give {} or tissue.contact.{} (its older spelling), not both", doc.where(pointer), key_name(pointer), item.key()));
       }
-    notes.push_back(older_spelling_note(doc.where("/tissue/contact/" + json_pointer_token(item.key())), item.key(), *now));
+    notes.push_back(older_spelling_note(doc.where("/tissue/contact/" + json_pointer_token(item.key())), "tissue.contact." + item.key(),
+                                        "tissue." + now->section + "." + now->key));
   }
   t.separation.needle_cut = c.boolean("cuts_bonds", t.separation.needle_cut);
   read_slit(c, "slit_", t.separation.slit);
@@ -480,7 +481,7 @@ Scene apply_named_scene_settings(const Scene& scene, const std::vector<NamedScen
     NEEDLE_REQUIRE(eq != std::string::npos && eq > 0, fmt::format("{}: give key=value, e.g. {}", shown, "--set tissue.material.E_MPa=0.1"));
     // A key in an older spelling sets the key it is now (tissue.contact.crack_reach_mm: tissue.separation.crack.reach_mm).
     const std::string given = setting.substr(0, eq), key = current_scene_key(given), value = setting.substr(eq + 1);
-    if (key != given) notes.push_back(fmt::format("{}: {} is read as {} (its place since 2026-11-28; docs/scenes.md)", shown, given, key));
+    if (key != given) notes.push_back(older_spelling_note(shown, given, key));
     keys.push_back(key);
     std::vector<std::string> path;
     for (size_t start = 0;;) {

@@ -54,9 +54,8 @@ std::string current_scene_key(const std::string& dotted_key) {
   return now ? "tissue." + now->section + "." + now->key : dotted_key;
 }
 
-std::string older_spelling_note(const std::string& where, const std::string& contact_key, const KeySpelling& now) {
-  return fmt::format("{}: tissue.contact.{} is read as tissue.{}.{} (its place since 2026-11-28; docs/scenes.md)", where, contact_key,
-                     now.section, now.key);
+std::string older_spelling_note(const std::string& where, const std::string& older_key, const std::string& current_key) {
+  return fmt::format("{}: {} is read as {} (its place since 2026-11-28; docs/scenes.md)", where, older_key, current_key);
 }
 
 }  // namespace needle

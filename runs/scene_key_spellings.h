@@ -26,7 +26,7 @@ std::optional<KeySpelling> current_contact_key(const std::string& contact_key);
 // other key as it is.
 std::string current_scene_key(const std::string& dotted_key);
 
-// The note a scene's reader leaves for an older spelling: "where: tissue.contact.X is read as tissue.S.Y (...)".
-std::string older_spelling_note(const std::string& where, const std::string& contact_key, const KeySpelling& now);
+// The note left for a key read in its older spelling: "where: tissue.contact.X is read as tissue.S.Y (...)" (dotted keys).
+std::string older_spelling_note(const std::string& where, const std::string& older_key, const std::string& current_key);
 
 }  // namespace needle

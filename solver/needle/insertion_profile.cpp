@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <string>
 #include <vector>
 
@@ -17,9 +18,7 @@ std::string InsertionProfile::describe() const {
     parts.push_back(fmt::format("the needle is driven at {:g} m/s (the paper's model: {:g})", speed_mm_per_ms, paper.speed_mm_per_ms));
   if (decel_time_ms != paper.decel_time_ms) parts.push_back(fmt::format("the base decelerates to rest over {:g} ms", decel_time_ms));
   if (hold_ms != paper.hold_ms) parts.push_back(fmt::format("delta is read after the base is held still for {:g} ms", hold_ms));
-  std::string d;
-  for (const std::string& p : parts) d += (d.empty() ? "" : "; ") + p;
-  return d;
+  return fmt::format("{}", fmt::join(parts, "; "));
 }
 
 void InsertionProfile::validate(const std::string& where) const {

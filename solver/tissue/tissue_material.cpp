@@ -4,6 +4,9 @@
 #include <cmath>
 #include <limits>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <string>
+#include <vector>
 
 #include "core/input_error.h"
 #include "solver/tissue/hencky_strain.h"
@@ -38,12 +41,12 @@ std::string rate_law_name(RateLaw law) {
 }
 
 std::string TissueMaterial::describe() const {
-  std::string d;
-  if (law == TissueLaw::stiffening_elastic) d = "the tissue stiffens as measured (stiffening_elastic: 3 G eps + k eps^n)";
+  std::vector<std::string> parts;
+  if (law == TissueLaw::stiffening_elastic) parts.emplace_back("the tissue stiffens as measured (stiffening_elastic: 3 G eps + k eps^n)");
   if (viscoelastic())
-    d += (d.empty() ? "" : "; ") + fmt::format("the gel relaxes viscoelastically ({:g} of the shear stress, time constant {:g} ms)",
-                                               relaxing_shear_fraction, relaxation_time_ms);
-  return d;
+    parts.push_back(fmt::format("the gel relaxes viscoelastically ({:g} of the shear stress, time constant {:g} ms)", relaxing_shear_fraction,
+                                relaxation_time_ms));
+  return fmt::format("{}", fmt::join(parts, "; "));
 }
 
 void TissueMaterial::validate() const {
