@@ -171,9 +171,20 @@ void ImplicitNeedle::step(double dt, NeedleLoads& loads) {
   Factor& factor = factor_for(dt);
   const double t0 = time_ms_, t1 = time_ms_ + dt;
   const Eigen::Vector3d e = supports_.direction;
-  const double accel = (supports_.profile.velocity_mm_per_ms(t1) - supports_.profile.velocity_mm_per_ms(t0)) / dt;  // the drive's mean
+  double accel = (supports_.profile.velocity_mm_per_ms(t1) - supports_.profile.velocity_mm_per_ms(t0)) / dt;  // the drive's mean
   const double drive_step = supports_.profile.displacement_mm(t1) - supports_.profile.displacement_mm(t0);
-  const Eigen::Vector3d momentum_before = momentum();
+  const Eigen::Vector3d momentum_before = momentum(), reaction_before = drive_reaction_;
+  // A stop without deceleration within the step (moving at the travel's end, still after it) is a jump of the base's
+  // velocity, not an acceleration the frame could carry as a load over the step: the held base stops at once and the
+  // free nodes keep their velocity (the steel rings axially), so their velocity relative to the base grows by the
+  // speed the base had, and the frame no longer accelerates.
+  const double travel_end = supports_.profile.travel_end_time_ms();
+  const bool stops_now = supports_.profile.decel_time_ms == 0 && t0 <= travel_end && travel_end < t1;
+  if (stops_now) {
+    const double jump = supports_.profile.velocity_mm_per_ms(t0) - supports_.profile.velocity_mm_per_ms(t1);
+    for (const int d : free_dof_) wd_[d] += jump * e[d % 3];
+    accel = 0;
+  }
   // The loads at the step's start, held over it (the contact's and the cannula's).
   evaluate_loads(loads);
 
@@ -214,7 +225,18 @@ void ImplicitNeedle::step(double dt, NeedleLoads& loads) {
     loads_sum += 0.5 * (old_load_.segment<3>(3 * i) + load_.segment<3>(3 * i) + old_cannula_load_.segment<3>(3 * i) + cannula_load_.segment<3>(3 * i));
   drive_reaction_ = (momentum() - momentum_before) / dt - loads_sum;
   drive_impulse_ += dt * drive_reaction_;
-  energy_.drive_work_mJ += drive_reaction_.dot(drive_step * e);
+  // The reaction's work through the base's motion. At a stop, the impulse J that stops the held base's mass works
+  // J . (v_before + v_after) / 2 (the base's kinetic energy); until the stop the base moved under the reaction it had
+  // before (after it, it does not move, and the reaction the stop sets up does no work).
+  if (stops_now) {
+    double held_mass = 0;
+    for (const int i : supports_.driven) held_mass += mass_[i];
+    const double v0 = supports_.profile.velocity_mm_per_ms(t0), v1 = supports_.profile.velocity_mm_per_ms(t1);
+    const Eigen::Vector3d stop_impulse = held_mass * (v1 - v0) * e;
+    energy_.drive_work_mJ += reaction_before.dot(drive_step * e) + stop_impulse.dot(0.5 * (v0 + v1) * e);
+  } else {
+    energy_.drive_work_mJ += drive_reaction_.dot(drive_step * e);
+  }
   energy_.external_work_mJ += external_work;
   energy_.cannula_work_mJ += cannula_work;
   old_load_ = load_;

@@ -181,6 +181,41 @@ TEST_CASE("Implicit needle: driven at its base it moves with the drive and the d
   CHECK_THROWS_AS(ImplicitNeedle(fe, driven_base_supports(fe.mesh(), profile), std::nullopt, options), InputError);
 }
 
+TEST_CASE("Implicit needle: stopped at once after its travel it rings with the kinetic energy it had, less its base's", "[solver][needle][gmsh]") {
+  // The drive ends at full speed and then holds the base (no deceleration): the base stops at once, the rest of the rod
+  // keeps its velocity and rings axially. Its energy after the stop is what it had less the held base's kinetic energy
+  // (the stopping impulse's work, m_base v^2 / 2), and its account stays closed over the ringing; its momentum is the
+  // drive's impulse throughout.
+  const FeNeedle fe(rod(), NeedleMaterial{}, 0.0);
+  InsertionProfile profile;
+  profile.accel_time_ms = 0.02;
+  profile.speed_mm_per_ms = 8.0;
+  profile.travel_mm = 0.3;
+  profile.hold_ms = 0.05;
+  NeedleDynamicsOptions options;
+  options.implicit_step_ms = 1e-3;
+  const NeedleSupports supports = driven_base_supports(fe.mesh(), profile);
+  ImplicitNeedle needle(fe, supports, std::nullopt, options);
+  TipLoad none;
+  needle.advance_to(profile.travel_end_time_ms(), none);
+  const double before_mJ = needle.energy().kinetic_mJ + needle.energy().strain_mJ;
+  double base_mass_g = 0;
+  for (const int i : supports.driven) base_mass_g += needle.nodal_mass_g()[i];
+  const double base_mJ = 0.5 * base_mass_g * profile.speed_mm_per_ms * profile.speed_mm_per_ms;
+  double worst_balance = 0;
+  while (needle.time_ms() < profile.end_time_ms() - 1e-12) {
+    needle.advance_to(std::min(profile.end_time_ms(), needle.time_ms() + 0.005), none);
+    worst_balance = std::max(worst_balance, needle.energy().balance_error());
+  }
+  const double after_mJ = needle.energy().kinetic_mJ + needle.energy().strain_mJ;
+  INFO("before " << before_mJ << " mJ, after " << after_mJ << " mJ, the base's " << base_mJ << " mJ");
+  CHECK(after_mJ == Approx(before_mJ - base_mJ).epsilon(0.01));
+  CHECK(needle.energy().kinetic_mJ < 0.9 * after_mJ);  // ringing: part of it is strain now
+  CHECK(worst_balance < 0.01);
+  CHECK((needle.momentum() - needle.drive_impulse_N_ms()).norm() < 1e-9 * std::max(1.0, needle.drive_impulse_N_ms().norm()));
+  CHECK(needle.drive_displacement_mm().x() == Approx(0.3).epsilon(1e-12));
+}
+
 TEST_CASE("Implicit needle: a rod pressed against the cannula's bore is held there as the explicit FE needle's cannula holds it",
           "[solver][needle][gmsh][slow]") {
   // The base at x = -8 held, the cannula's front at x = -3 with 0.025 mm of clearance around the rod: a tip
