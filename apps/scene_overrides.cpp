@@ -61,6 +61,14 @@ const std::vector<SceneFlagRow>& scene_flag_rows() {
       {"--crack-lead-mm", "tissue.separation.crack.lead_mm", T::value, "",
        "The crack's front runs this far ahead of tip point A, so the gel splits before the tip reaches it (default 0: "
        "it opens as the tip passes; scene key tissue.separation.crack.lead_mm)"},
+      {"--fire-cannula", "cannula.firing.enabled", T::nothing, "true",
+       "After the travel, fire the cannula over the groove (the trucut's third step) and measure the tissue sample it "
+       "encloses: its length I_s, volume and mass (summary.json \"sample\"; default off; scene section cannula.firing)"},
+      {"--firing-speed-m-per-s", "cannula.firing.speed_m_per_s", T::value, "",
+       "The fired cannula's speed (the paper's device: about 4 m/s, the default; scene key cannula.firing.speed_m_per_s)"},
+      {"--firing-throw-mm", "cannula.firing.throw_mm", T::value, "",
+       "The fired cannula's throw from its front at rest (default: to the groove's far end; the paper's device throws "
+       "25 mm; scene key cannula.firing.throw_mm)"},
       {"--groove-start-mm", "needle.groove_start_mm", T::value, "",
        "The groove's front wall this far behind tip point A. The paper does not give it; the presets' 3 mm clears the SB "
        "bevel's heel (2.3 mm) (default: the recipe's; scene key needle.groove_start_mm)"},

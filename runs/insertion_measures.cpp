@@ -1,5 +1,6 @@
 #include "runs/insertion_measures.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace needle {
@@ -19,6 +20,16 @@ PulledBackTissue pulled_back_tissue(CoupledInsertion& run, const Scene& scene) {
           scene.tissue.entry_x_mm - drive_x, scene.tissue.entry_x_mm + scene.tissue.size_mm.x() - drive_x};
 }
 
+// Per particle: in contact with a triangle of the needle's groove floor.
+std::vector<std::uint8_t> touching_groove_floor(NeedleTissueContact& contact, size_t particles) {
+  std::vector<std::uint8_t> touches(particles, 0);
+  const ContactSurface& surface = contact.surface();
+  for (const auto& [particle, triangle] : contact.contacts())
+    if (triangle >= 0 && surface.tag_names()[static_cast<size_t>(surface.triangle_tag(triangle))] == "groove_floor")
+      touches[static_cast<size_t>(particle)] = 1;
+  return touches;
+}
+
 }  // namespace
 
 GrooveFill run_groove_fill(CoupledInsertion& run, const SceneNeedle& needle, const Scene& scene) {
@@ -33,12 +44,35 @@ GrooveFill run_groove_fill(CoupledInsertion& run, const SceneNeedle& needle, con
   in.tissue_max_x_mm = tissue.max_x_mm;
   in.reference_points = std::move(tissue.points);
   in.spacing_mm = p.spacing_mm;
-  in.touches_floor.assign(in.reference_points.size(), 0);
-  const ContactSurface& surface = contact.surface();
-  for (const auto& [particle, triangle] : contact.contacts())
-    if (triangle >= 0 && surface.tag_names()[static_cast<size_t>(surface.triangle_tag(triangle))] == "groove_floor")
-      in.touches_floor[static_cast<size_t>(particle)] = 1;
+  in.touches_floor = touching_groove_floor(contact, in.reference_points.size());
   return measure_groove_fill(in);
+}
+
+std::vector<std::uint8_t> groove_floor_contacts(CoupledInsertion& run) {
+  return touching_groove_floor(run.contact_model(), run.tissue().particles().position_mm.size());
+}
+
+TissueSample run_tissue_sample(CoupledInsertion& run, const SceneNeedle& needle, const CannulaFiring& firing,
+                               std::vector<std::uint8_t> touched_floor) {
+  const TissueParticles& p = run.tissue().particles();
+  TissueSampleInput in;
+  in.reference_points = firing.reference_points(p.position_mm, run.needle().positions_mm());
+  in.spacing_mm = p.spacing_mm;
+  in.volume_mm3 = p.reference_volume_mm3;
+  const double density = run.tissue().material().density_g_per_mm3();
+  in.mass_g.resize(in.volume_mm3.size());
+  for (size_t i = 0; i < in.mass_g.size(); ++i) in.mass_g[i] = density * in.volume_mm3[i];  // physical, whatever the mass scaling
+  in.touches_floor = std::move(touched_floor);
+  in.bore_radius_mm = firing.tube().mid_radius_mm();
+  const double front = firing.stroke().front_x_mm(run.time_ms());
+  in.x_lo_mm = firing.stroke().start_x_mm;
+  in.x_hi_mm = front;
+  if (needle.groove) {
+    in.x_lo_mm = std::max(in.x_lo_mm, needle.groove->back_x_mm);
+    in.x_hi_mm = std::min(in.x_hi_mm, needle.groove->front_x_mm);
+    in.floor_y_mm = needle.groove->floor_y_mm;
+  }
+  return measure_tissue_sample(in);
 }
 
 StrainProbes run_strain_probes(CoupledInsertion& run, const SceneNeedle& needle, const Scene& scene) {

@@ -95,12 +95,23 @@ void InsertionOutput::frame(const CoupledInsertion& run) {
     mises[i] = std::sqrt(1.5 * dev.squaredNorm());
     contact[i] = in_contact[s];
   }
+  std::vector<VtkField> fields = {{"displacement_mm", u},
+                                  {"velocity_m_per_s", v},
+                                  {"plastic_strain", plastic},
+                                  {"effective_strain", effective},
+                                  {"min_principal_strain", min_principal},
+                                  {"von_mises_MPa", mises},
+                                  {"broken_bonds", broken_bonds(run.tissue())},
+                                  {"in_contact", contact}};
+  // A fired cannula's frames mark the particles in its bore behind its front (the sample, and the clearance's layer).
+  if (const CannulaFiring* firing = run.cannula_firing()) {
+    const std::vector<std::uint8_t> inside = firing->inside_bore(p.position_mm, run.needle().positions_mm(), run.time_ms());
+    Eigen::VectorXd in_cannula(np);
+    for (Eigen::Index i = 0; i < np; ++i) in_cannula[i] = inside[static_cast<size_t>(i)];
+    fields.push_back({"in_cannula", in_cannula});
+  }
   const std::string tissue_name = fmt::format("frames/tissue_{:04}.vtp", index);
-  write_vtp(folder_.path(tissue_name).string(), x,
-            {{"displacement_mm", u}, {"velocity_m_per_s", v}, {"plastic_strain", plastic}, {"effective_strain", effective},
-             {"min_principal_strain", min_principal}, {"von_mises_MPa", mises},
-             {"broken_bonds", broken_bonds(run.tissue())}, {"in_contact", contact}},
-            VtkEncoding::binary);
+  write_vtp(folder_.path(tissue_name).string(), x, fields, VtkEncoding::binary);
   tissue_frames_.emplace_back(run.time_ms(), tissue_name);
 }
 

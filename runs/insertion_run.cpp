@@ -10,12 +10,16 @@
 #include "runs/model_levels.h"
 #include "runs/run_driver.h"
 #include "runs/run_folder.h"
+#include "runs/sample_picture.h"
 #include "runs/scene_needle.h"
 #include "runs/scene_particles.h"
 #include "core/input_error.h"
 #include "mesher/particle_lattice.h"
+#include "solver/insertion/cannula_firing.h"
+#include "solver/needle/held_needle.h"
 #include "solver/insertion/coupled_insertion.h"
 #include "solver/needle/needle_models.h"
+#include "solver/separation/cannula_edge_cut.h"
 #include "solver/separation/separation_models.h"
 
 namespace needle {
@@ -23,6 +27,33 @@ namespace {
 
 using nlohmann::json;
 using Clock = std::chrono::steady_clock;
+
+// The fired cannula's tube: the scene cannula's bore and outer radius.
+CannulaTube firing_tube(const Scene& scene, double rod_radius_mm) {
+  return {scene.cannula.inner_radius_mm(), 0.5 * scene.cannula.outer_diameter_mm, scene.cannula_firing.edge_taper_mm, rod_radius_mm};
+}
+
+// The fired cannula's stroke in the needle's reference frame (solver/insertion/cannula_firing.h): from the cannula's
+// front at rest (the scene cannula's front, carried back by the travel), or lead_in_mm behind the groove's back wall if
+// that is farther forward, to the groove's front wall or the throw; it starts moving after the travel, its hold and
+// the dwell.
+CannulaStroke firing_stroke(const Scene& scene, const GrooveBox& groove) {
+  const CannulaFiringOptions& f = scene.cannula_firing;
+  NEEDLE_REQUIRE(scene.direction.normalized().isApprox(Eigen::Vector3d::UnitX(), 1e-12),
+                 "cannula.firing: the cannula is fired along the needle's axis, x: it needs motion.direction [1, 0, 0]");
+  const double rest_front_x = scene.cannula.front_x_mm - scene.motion.travel_mm;
+  CannulaStroke stroke;
+  stroke.speed_mm_per_ms = f.speed_mm_per_ms;
+  stroke.start_time_ms = scene.motion.end_time_ms() + f.dwell_ms;
+  stroke.stop_x_mm = std::isnan(f.throw_mm) ? groove.front_x_mm : rest_front_x + f.throw_mm;
+  NEEDLE_REQUIRE(stroke.stop_x_mm > groove.back_x_mm,
+                 fmt::format("cannula.firing.throw_mm {:g} mm stops the cannula's front {:.3g} mm behind the groove's back wall: it "
+                             "would take no tissue (the groove spans {:.3g} to {:.3g} mm from the cannula's front at rest)",
+                             f.throw_mm, groove.back_x_mm - stroke.stop_x_mm, groove.back_x_mm - rest_front_x,
+                             groove.front_x_mm - rest_front_x));
+  stroke.start_x_mm = std::min(stroke.stop_x_mm, std::max(rest_front_x, groove.back_x_mm - f.lead_in_mm));
+  return stroke;
+}
 
 // The coupled insertion of a scene as the run driver runs it (run_driver.h).
 class InsertionRunModel : public RunModel {
@@ -50,6 +81,12 @@ class InsertionRunModel : public RunModel {
     SeparationOptions separation = scene.tissue.separation;
     if (!ground_tip) separation.lip.mode = LipReleaseMode::off;
     std::vector<std::unique_ptr<SeparationModel>> separations = make_separation_models(separation, *surface_);
+    if (scene.cannula_firing.enabled) {
+      NEEDLE_REQUIRE(built_.groove, "cannula.firing takes the tissue in the needle's groove: it needs a needle with one (a preset, d_a or a "
+                                    "recipe with a groove; not a plain rod or a mesh file)");
+      firing_ = std::make_unique<CannulaFiring>(firing_tube(scene, built_.radius_mm), firing_stroke(scene, *built_.groove), NeedleAxisFrame(built_.mesh.X));
+      separations.push_back(std::make_unique<CannulaEdgeCut>(*firing_));
+    }
     setup_s_ = std::chrono::duration<double>(Clock::now() - start).count();
     NeedleDynamicsOptions dynamics = scene_dynamics_options(scene);
     // The implicit needle's step by default: about half the tissue's stable step at the start, a whole fraction
@@ -62,6 +99,8 @@ class InsertionRunModel : public RunModel {
     needle_model_ = make_needle_model(scene.needle.model, {*needle_, driven_base_supports(needle_->mesh(), scene.motion, scene.direction),
                                                            scene.cannula.enabled ? std::optional<CannulaOptions>(scene.cannula) : std::nullopt,
                                                            dynamics});
+    // With a fired cannula the needle is held still from the insertion's end (held_needle.h): the device stops it.
+    if (scene.cannula_firing.enabled) needle_model_ = std::make_unique<HeldNeedle>(std::move(needle_model_), scene.motion.end_time_ms());
     // The tissue's mass scaling target unless a step is given: a quarter of the implicit needle's step (the
     // coupling steps are whole eighths of it), for an explicit needle half the tissue's first. The quarter is its
     // measured error at 30 mm: 0.10 mm on HMB, none on SB, where the needle's whole step left 0.32 and 0.05 mm
@@ -75,6 +114,7 @@ class InsertionRunModel : public RunModel {
                                                                               : 0.5 * tissue_->stable_time_step_ms();
     run_ = std::make_unique<CoupledInsertion>(*needle_model_, *tissue_, *surface_, scene.tissue.contact, std::move(separations), coupling,
                                               cutting);
+    if (firing_) run_->fire_cannula(firing_.get());
     tip_ = nearest_node(needle_->mesh(), built_.tip_point);
   }
 
@@ -82,7 +122,7 @@ class InsertionRunModel : public RunModel {
   std::vector<std::string> setup_log() const override {
     const FeNeedle& n = *needle_;
     const ContactSurface& surface = *surface_;
-    return {fmt::format("needle {}: {} T{} elements, {} nodes, meshed in {:.2f} s", built_.name, built_.mesh.num_tets(),
+    std::vector<std::string> lines = {fmt::format("needle {}: {} T{} elements, {} nodes, meshed in {:.2f} s", built_.name, built_.mesh.num_tets(),
                         built_.mesh.order == 2 ? 10 : 4, built_.mesh.num_nodes(), built_.mesh_seconds),
             fmt::format("model {}: {} needle, {} contact, {} kernel supports", model_level_of(scene_), needle_model_->name(),
                         run_->contact_model().law(), support_shape_name(scene_.tissue.spg.support)),
@@ -100,25 +140,65 @@ class InsertionRunModel : public RunModel {
                             ? fmt::format("; particles whose own step falls below {:.4g} ms get mass (tissue mass scaling)",
                                           run_->tissue_dynamics().mass_scaling()->target_dt_ms())
                             : std::string())};
+    if (firing_) lines.push_back(firing_log());
+    return lines;
   }
-  double end_time_ms() const override { return scene_.motion.end_time_ms(); }
+  std::string firing_log() const {
+    const CannulaStroke& s = firing_->stroke();
+    return fmt::format("cannula fired at {:.6g} ms at {:g} m/s, its front from {:.4g} to {:.4g} mm in the needle's frame (the groove: {:.4g} to "
+                       "{:.4g} mm), until {:.6g} ms; bore {:.4g} mm, outer radius {:.4g} mm, the edge cuts along {:.4g} mm",
+                       s.start_time_ms, s.speed_mm_per_ms, s.start_x_mm, s.stop_x_mm, built_.groove->back_x_mm, built_.groove->front_x_mm,
+                       s.end_time_ms(), firing_->tube().inner_radius_mm, firing_->tube().outer_radius_mm, firing_->tube().mid_radius_mm());
+  }
+  // With a fired cannula the run goes on past the insertion to the stroke's end.
+  double end_time_ms() const override { return firing_ ? firing_->stroke().end_time_ms() : scene_.motion.end_time_ms(); }
   double time_ms() const override { return run_->time_ms(); }
   long steps() const override { return run_->steps(); }
-  void step(double end_time_ms) override { run_->step(end_time_ms); }
+  void step(double end_time_ms) override {
+    if (!firing_) return run_->step(end_time_ms);
+    // The insertion's end is landed on: its deflection and groove are what the cannula's firing leaves as they were.
+    const double insertion_end = scene_.motion.end_time_ms();
+    run_->step(time_ms() < insertion_end - 1e-12 ? std::min(end_time_ms, insertion_end) : end_time_ms);
+    if (!at_insertion_end_ && time_ms() >= insertion_end - 1e-12) {
+      at_insertion_end_ = InsertionEnd{tip_displacement_now(), needle_model_->drive_displacement_mm(), run_groove_fill(*run_, built_, scene_),
+                                       strain_probes_json(run_strain_probes(*run_, built_, scene_), needle_model_->drive_displacement_mm().norm(),
+                                                          deflection_now())};
+    }
+  }
   void open_outputs(const RunFolder& folder) override { output_ = std::make_unique<InsertionOutput>(folder, *surface_, run_->separations()); }
   void record() override {
     output_->record(*run_, tip_, run_groove_fill(*run_, built_, scene_));
+    // Over the stroke, which particles touched the groove floor: the sample's I_s counts the tissue on the floor as the
+    // edge cut it, which may lift off once cut free.
+    if (firing_ && firing_->active(time_ms())) {
+      const std::vector<std::uint8_t> now = groove_floor_contacts(*run_);
+      if (touched_floor_.empty()) touched_floor_.assign(now.size(), 0);
+      for (size_t i = 0; i < now.size(); ++i) touched_floor_[i] |= now[i];
+    }
     // The strains where the paper shows them at L = 4.8 mm: at the first record past it.
     const double insertion_mm = needle_model_->drive_displacement_mm().norm();
     if (early_probes_.is_null() && insertion_mm >= kEarlyProbeInsertionMm)
       early_probes_ = strain_probes_json(run_strain_probes(*run_, built_, scene_), insertion_mm, deflection_mm());
   }
   void frame(const RunFolder&) override { output_->frame(*run_); }
-  void close_outputs(const RunFolder&) override { output_->finish(); }
-  Eigen::Vector3d tip_displacement_mm() const override {
-    return (needle_model_->positions_mm().row(tip_) - needle_->mesh().X.row(tip_)).transpose();
+  void close_outputs(const RunFolder& folder) override {
+    output_->finish();
+    if (!firing_) return;
+    // The sample as the stroke leaves it, and its picture.
+    const std::vector<std::uint8_t> touched = touched_floor_.empty() ? groove_floor_contacts(*run_) : touched_floor_;
+    sample_ = run_tissue_sample(*run_, built_, *firing_, touched);
+    sample_on_floor_at_end_ = run_tissue_sample(*run_, built_, *firing_, groove_floor_contacts(*run_));
+    SamplePictureInput picture{firing_->reference_points(run_->tissue().particles().position_mm, needle_model_->positions_mm()), touched, *sample_,
+                               *built_.groove, built_.radius_mm, firing_->tube()};
+    write_png(draw_sample_picture(picture), folder.path("sample.png").string());
   }
-  Eigen::Vector3d drive_displacement_mm() const override { return needle_model_->drive_displacement_mm(); }
+  // With a fired cannula, the tip's and the drive's at the insertion's end (the deflection the firing leaves alone).
+  Eigen::Vector3d tip_displacement_mm() const override { return at_insertion_end_ ? at_insertion_end_->tip_mm : tip_displacement_now(); }
+  Eigen::Vector3d drive_displacement_mm() const override {
+    return at_insertion_end_ ? at_insertion_end_->drive_mm : needle_model_->drive_displacement_mm();
+  }
+  Eigen::Vector3d tip_displacement_now() const { return (needle_model_->positions_mm().row(tip_) - needle_->mesh().X.row(tip_)).transpose(); }
+  double deflection_now() const { return tip_displacement_now().y() - needle_model_->drive_displacement_mm().y(); }
   double energy_balance_error() const override { return run_->energy().balance_error(); }
   double max_energy_balance_error() const override { return run_->max_energy_error(); }
 
@@ -137,6 +217,10 @@ class InsertionRunModel : public RunModel {
     summary["energy_mJ"] = {{"drive_work", e.drive_work_mJ}, {"tissue_internal", e.tissue_internal_mJ}, {"tissue_kinetic", e.tissue_kinetic_mJ},
                             {"needle_kinetic", e.needle_kinetic_mJ}, {"needle_strain", e.needle_strain_mJ}, {"contact_work", e.contact_work_mJ},
                             {"penalty", e.penalty_energy_mJ}, {"friction_dissipation", e.friction_dissipation_mJ}, {"cannula_work", e.cannula_work_mJ}};
+    if (firing_) {  // the fired cannula's terms (absent from a run without one)
+      summary["energy_mJ"]["needle_held"] = e.needle_held_mJ;
+      summary["energy_mJ"]["cannula_firing_wall"] = e.firing_work_mJ;
+    }
     summary["max_penetration_mm"] = run_->max_depth_mm();
     summary["particles_inside"] = run_->contact().particles_inside;
     summary["max_particles_inside"] = run_->max_particles_inside();
@@ -172,10 +256,41 @@ class InsertionRunModel : public RunModel {
                                                "touching the top facets (tip_top), touching the tip within 2 mm behind A and no higher than A "
                                                "(below_tip), and inside the groove (groove); median, 5th percentile and minimum"}};
     if (!early_probes_.is_null()) summary["strain_probes"]["early"] = early_probes_;
-    summary["strain_probes"]["end"] =
-        strain_probes_json(run_strain_probes(*run_, built_, scene_), needle_model_->drive_displacement_mm().norm(), deflection_mm());
+    summary["strain_probes"]["end"] = at_insertion_end_ ? at_insertion_end_->strain_probes
+                                                        : strain_probes_json(run_strain_probes(*run_, built_, scene_),
+                                                                             needle_model_->drive_displacement_mm().norm(), deflection_mm());
+    if (firing_) add_sample_summary(summary);
     if (run_->cutting()) run_->cutting()->add_summary(summary);
     for (const auto& separation : run_->separations()) separation->add_summary(summary, run_->tissue());
+  }
+  // The sample the fired cannula encloses (solver/insertion/tissue_sample.h), the stroke, and the groove before the firing.
+  void add_sample_summary(json& summary) const {
+    if (!sample_) return;  // the run stopped before its outputs were closed
+    const TissueSample& sample = *sample_;
+    const TissueSample& on_floor_at_end = *sample_on_floor_at_end_;
+    const CannulaStroke& s = firing_->stroke();
+    const GrooveFill before = at_insertion_end_ ? at_insertion_end_->groove : GrooveFill{};
+    summary["sample"] = {
+        {"I_s_mm", sample.floor_length_mm},
+        {"floor_length_mm", sample.floor_length_mm},
+        {"floor_covered_mm", sample.floor_covered_mm},
+        {"floor_length_at_end_mm", on_floor_at_end.floor_length_mm},
+        {"length_mm", sample.length_mm},
+        {"volume_mm3", sample.volume_mm3},
+        {"mass_g", sample.mass_g},
+        {"particles", sample.particles},
+        {"floor_particles", sample.floor_particles},
+        {"back_x_mm", sample.back_x_mm},
+        {"front_x_mm", sample.front_x_mm},
+        {"cannula", {{"speed_m_per_s", s.speed_mm_per_ms}, {"start_time_ms", s.start_time_ms}, {"end_time_ms", s.end_time_ms()},
+                     {"start_x_mm", s.start_x_mm}, {"stop_x_mm", s.stop_x_mm}, {"front_x_mm_at_end", s.front_x_mm(run_->time_ms())},
+                     {"bore_radius_mm", firing_->tube().inner_radius_mm}, {"outer_radius_mm", firing_->tube().outer_radius_mm},
+                     {"wall_pushes", firing_->pushes()}, {"max_push_mm", firing_->max_push_mm()}, {"wall_work_mJ", firing_->work_mJ()}}},
+        {"groove_before_firing", {{"groove_fill", before.groove_fill}, {"floor_contact_fraction", before.floor_contact_fraction},
+                                  {"mean_gap_mm", before.mean_gap_mm}}},
+        {"definition", "solver/insertion/tissue_sample.h: the particles inside the cannula's mid-wall radius, between the groove's walls within "
+                       "the stroke, above the groove floor less half a spacing, in the needle's reference frame; I_s_mm is the extent along the "
+                       "axis of those that touched the groove floor at a record during the stroke (floor_length_at_end_mm: touching it at the end); x in the needle's reference frame (tip point A at 0)"}};
   }
   std::string log_steps(double solve_s) const override {
     return fmt::format("{} coupling steps and {} needle steps in {:.2f} s, energy balance error {:.3g}, max penetration {:.3g} mm, {} particles "
@@ -203,7 +318,16 @@ class InsertionRunModel : public RunModel {
   ParticleSet particles_;
   std::unique_ptr<SpgTissue> tissue_;
   std::unique_ptr<NeedleModel> needle_model_;
+  std::unique_ptr<CannulaFiring> firing_;  // the cannula fired after the travel (null: none); outlives run_, whose edge cut reads it
   std::unique_ptr<CoupledInsertion> run_;
+  struct InsertionEnd {  // with a fired cannula: what the insertion's end left
+    Eigen::Vector3d tip_mm, drive_mm;
+    GrooveFill groove;
+    json strain_probes;
+  };
+  std::optional<InsertionEnd> at_insertion_end_;
+  std::vector<std::uint8_t> touched_floor_;  // per particle: touched the groove floor at a record during the stroke
+  std::optional<TissueSample> sample_, sample_on_floor_at_end_;  // at the run's end (close_outputs)
   int tip_ = 0;
   double setup_s_ = 0;
   std::unique_ptr<InsertionOutput> output_;

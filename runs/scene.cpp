@@ -108,7 +108,21 @@ void read_motion(SceneObject o, Scene& s) {
   o.finish();
 }
 
-void read_cannula(SceneObject o, CannulaOptions& c) {
+void read_cannula_firing(SceneObject o, CannulaFiringOptions& f) {
+  f.enabled = o.boolean("enabled", f.enabled);
+  f.speed_mm_per_ms = o.quantity("speed", Dimension::speed, f.speed_mm_per_ms, [](double v) {
+    return v > 0 && v <= InsertionProfile::kMaxSpeedMPerS
+               ? std::string()
+               : fmt::format("must be positive and at most {:g} m/s (the paper's device: about 4 m/s)", InsertionProfile::kMaxSpeedMPerS);
+  });
+  f.throw_mm = o.quantity("throw", Dimension::length, f.throw_mm, positive());
+  f.dwell_ms = o.quantity("dwell", Dimension::time, f.dwell_ms, non_negative());
+  f.lead_in_mm = o.quantity("lead_in", Dimension::length, f.lead_in_mm, non_negative());
+  f.edge_taper_mm = o.quantity("edge_taper", Dimension::length, f.edge_taper_mm, non_negative());
+  o.finish();
+}
+
+void read_cannula(SceneObject o, CannulaOptions& c, CannulaFiringOptions& firing) {
   c.enabled = o.boolean("enabled", c.enabled);
   c.outer_diameter_mm = o.quantity("outer_diameter", Dimension::length, c.outer_diameter_mm, positive());
   c.wall_mm = o.quantity("wall", Dimension::length, c.wall_mm, positive());
@@ -117,6 +131,7 @@ void read_cannula(SceneObject o, CannulaOptions& c) {
   c.friction = o.number("friction", c.friction, friction_coefficient());
   c.penalty_scale = o.number("penalty_scale", c.penalty_scale, within(1e-6, 0.5));
   NEEDLE_REQUIRE(c.wall_mm < 0.5 * c.outer_diameter_mm, fmt::format("{}: the wall leaves no bore", o.where("wall_mm")));
+  if (o.has("firing")) read_cannula_firing(o.child("firing"), firing);
   o.finish();
 }
 
@@ -340,7 +355,7 @@ Scene scene_from_document(const JsonDocument& doc, Scene s = {}) {
   if (root.has("needle")) read_needle(root.child("needle"), s.needle, folder);
   else s.needle.preset = "SB";
   if (root.has("motion")) read_motion(root.child("motion"), s);
-  if (root.has("cannula")) read_cannula(root.child("cannula"), s.cannula);
+  if (root.has("cannula")) read_cannula(root.child("cannula"), s.cannula, s.cannula_firing);
   if (root.has("tissue")) read_tissue(root.child("tissue"), s.tissue, doc, s.notes);
   if (root.has("solver")) read_solver(root.child("solver"), s.solver);
   if (root.has("output")) read_output(root.child("output"), s.output);
@@ -353,6 +368,9 @@ Scene scene_from_document(const JsonDocument& doc, Scene s = {}) {
     throw InputError(fmt::format("{}: {}: the slit opens the symmetry plane, so it needs a half model (needle.half_model true)",
                                  doc.where(slit), key_name(slit)));
   }
+  NEEDLE_REQUIRE(!s.cannula_firing.enabled || s.tissue.enabled,
+                 fmt::format("{}: the cannula is fired over the groove to take a tissue sample: it needs tissue (tissue.enabled true)",
+                             doc.where("/cannula/firing/enabled")));
   NEEDLE_REQUIRE(!s.tissue.enabled || s.tissue.entry_x_mm < s.motion.travel_mm,
                  fmt::format("{}: tissue.entry_x_mm {} mm is not less than the travel ({} mm): the tip would never reach the tissue",
                              doc.where("/tissue/entry_x_mm"), s.tissue.entry_x_mm, s.motion.travel_mm));
@@ -454,12 +472,19 @@ json scene_to_json(const Scene& s) {
     solver["tissue_rate_needle_margin_mm"] = s.solver.coupling.tissue_rate_needle_margin_mm;
     solver["tissue_rate_safety"] = s.solver.coupling.tissue_rate_safety;
   }
+  json cannula = {{"enabled", c.enabled},       {"outer_diameter_mm", c.outer_diameter_mm}, {"wall_mm", c.wall_mm},
+                 {"front_x_mm", c.front_x_mm}, {"length_mm", c.length_mm},                 {"friction", c.friction},
+                 {"penalty_scale", c.penalty_scale}};
+  // Written only when fired (issue 50): scenes without it stay as they were.
+  if (const CannulaFiringOptions& f = s.cannula_firing; f.enabled) {
+    cannula["firing"] = {{"enabled", true},          {"speed_m_per_s", f.speed_mm_per_ms}, {"dwell_ms", f.dwell_ms},
+                         {"lead_in_mm", f.lead_in_mm}, {"edge_taper_mm", f.edge_taper_mm}};
+    if (!std::isnan(f.throw_mm)) cannula["firing"]["throw_mm"] = f.throw_mm;  // absent: to the groove's far end
+  }
   return {
       {"needle", needle},
       {"motion", motion},
-      {"cannula", {{"enabled", c.enabled}, {"outer_diameter_mm", c.outer_diameter_mm}, {"wall_mm", c.wall_mm},
-                   {"front_x_mm", c.front_x_mm}, {"length_mm", c.length_mm}, {"friction", c.friction},
-                   {"penalty_scale", c.penalty_scale}}},
+      {"cannula", cannula},
       {"tissue", tissue},
       {"solver", solver},
       {"output", {{"history_interval_ms", s.output.history_interval_ms}, {"frames", s.output.frames}}},

@@ -12,6 +12,7 @@
 #include "mesher/needle_mesher.h"
 #include "mesher/particle_lattice.h"
 #include "solver/needle/insertion_profile.h"
+#include "solver/insertion/cannula_firing.h"
 #include "solver/insertion/coupled_insertion.h"
 #include "solver/separation/separation_models.h"
 #include "solver/tissue/spg_options.h"
@@ -97,6 +98,7 @@ struct Scene {
   InsertionProfile motion;
   Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
   CannulaOptions cannula;
+  CannulaFiringOptions cannula_firing;  // section cannula.firing: the cannula fired over the groove after the travel
   TissueScene tissue;
   SolverScene solver;
   OutputScene output;

@@ -13,7 +13,9 @@
 //      particles away from the needle update their stresses (step 6's first stage, which the contact cannot change);
 //   5. the contact ends the step: its force at t + dt on the particles (penalty) or its impulses (projection);
 //   6. the tissue's second half: its forces at t + dt with the contact's, the half kick;
-//   7. each separation model separates the tissue (the needle's cut, the slit, the crack, the lip's release);
+//   5b. a fired cannula (cannula_firing.h), when there is one, pushes the tissue out of its wall;
+//   7. each separation model separates the tissue (the needle's cut, the slit, the crack, the lip's release, a fired
+//      cannula's edge);
 //   8. the energy account, penetration and drift checks (each body checks its own NaN and blow-up).
 // Each step, the needle receives -C(t) over its substeps and the tissue (C(t) + C(t + dt)) dt / 2: momentum
 // is exchanged exactly up to a half-step lag that never accumulates (it telescopes to dt/2 |C(end) - C(0)|).
@@ -30,6 +32,7 @@
 
 #include "solver/contact/cutting_resistance.h"
 #include "solver/contact/needle_tissue_contact.h"
+#include "solver/insertion/cannula_firing.h"
 #include "solver/insertion/insertion_energy.h"
 #include "solver/needle/needle_model.h"
 #include "solver/separation/separation_model.h"
@@ -79,6 +82,11 @@ class CoupledInsertion {
                    std::vector<std::unique_ptr<SeparationModel>> separations, const CouplingOptions& coupling,
                    const CuttingOptions& cutting = {});
 
+  // The cannula fired over the needle after its travel (cannula_firing.h), before the first step; it must outlive this
+  // object, and its edge's cut is one of the separation models (separation/cannula_edge_cut.h). Null: none.
+  void fire_cannula(CannulaFiring* firing);
+  const CannulaFiring* cannula_firing() const { return firing_; }
+
   // One coupling step, shortened to land on end_time_ms.
   void step(double end_time_ms);
 
@@ -113,6 +121,8 @@ class CoupledInsertion {
   void flag_particles_by_needle_box(double margin_mm, bool inside, std::vector<std::uint8_t>& flags) const;
   // Flags the particles away from the needle (CouplingOptions::tissue_beside_needle) into still_.
   void mark_particles_away_from_needle();
+  double cannula_reach_mm() const;  // how far beyond the needle's box a fired cannula may move particles now
+  static constexpr double kCannulaReachSafetyMm = 0.05;
   // Holds the particles near the needle at the coupling step for the next cycle of the rate levels.
   void hold_particles_near_needle_fast();
   void check_health();  // penetration and the energy balance; SolverError beyond their limits
@@ -130,6 +140,7 @@ class CoupledInsertion {
     void needle_forces(const Eigen::MatrixX3d& x_mm, const Eigen::MatrixX3d& v_mm_per_ms, double time_ms, NodalForces& force_N) override;
   } loads_;
   std::vector<std::unique_ptr<SeparationModel>> separations_;
+  CannulaFiring* firing_ = nullptr;
   std::vector<Vec3d> contact_force_N_;  // the contact's force on each particle at the step's end
   std::vector<std::uint8_t> still_;     // particles away from the needle this step
   Eigen::MatrixX3d needle_x_before_;    // the needle's nodes at the last step's start

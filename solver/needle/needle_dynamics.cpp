@@ -11,9 +11,9 @@
 namespace needle {
 
 double NeedleEnergy::balance_error() const {
-  const double residual = kinetic_mJ + strain_mJ - initial_mJ - drive_work_mJ - cannula_work_mJ - external_work_mJ;
+  const double residual = kinetic_mJ + strain_mJ + held_mJ - initial_mJ - drive_work_mJ - cannula_work_mJ - external_work_mJ;
   const double scale = std::max({std::abs(kinetic_mJ), std::abs(strain_mJ), std::abs(initial_mJ), std::abs(drive_work_mJ),
-                                 std::abs(cannula_work_mJ), std::abs(external_work_mJ), 1e-300});
+                                 std::abs(cannula_work_mJ), std::abs(external_work_mJ), std::abs(held_mJ), 1e-300});
   return std::abs(residual) / scale;
 }
 

@@ -24,7 +24,8 @@ using NodalForces = std::vector<std::pair<int, Eigen::Vector3d>>;
 struct NeedleEnergy {
   double kinetic_mJ = 0, strain_mJ = 0, initial_mJ = 0;
   double drive_work_mJ = 0, cannula_work_mJ = 0, external_work_mJ = 0;
-  // |KE + U - E0 - W_drive - W_cannula - W_external| / the largest of those terms.
+  double held_mJ = 0;  // the kinetic energy the supports took when they held the needle still (held_needle.h)
+  // |KE + U + E_held - E0 - W_drive - W_cannula - W_external| / the largest of those terms.
   double balance_error() const;
 };
 

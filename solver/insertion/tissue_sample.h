@@ -1,0 +1,40 @@
+#pragma once
+// The biopsy sample (issue 50): the tissue the fired cannula encloses in the groove when it stops.
+//
+// Measured in the needle's reference frame (solver/needle/needle_axis_frame.h), where the cannula is a straight tube
+// around the x axis. A particle is captured when its centre lies inside the tube's mid-wall cylinder (the surface
+// its edge cut along, cannula_firing.h), between x_lo and x_hi (the groove's walls, within the cannula's stroke), and
+// above the groove's floor less half its spacing (so the tissue in the clearance beside the rod below the floor is
+// not counted; without a groove, every particle in the bore counts). A particle stands for the tissue within half its
+// spacing of its centre along x.
+//   length_mm:       the extent along the axis of all captured tissue (its front edge less its back edge);
+//   floor_length_mm: the extent of the captured tissue touching the groove floor (a contact with a groove_floor
+//                    triangle): the sample length I_s compared with the paper's;
+//   floor_covered_mm: the length of the axis under floor-touching tissue (gaps left out), at most floor_length_mm;
+//   volume_mm3, mass_g: the captured particles' reference volume and (physical) mass.
+#include <Eigen/Dense>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+namespace needle {
+
+struct TissueSampleInput {
+  std::vector<Eigen::Vector3d> reference_points;  // per particle, in the needle's reference frame
+  std::vector<double> spacing_mm, volume_mm3, mass_g;
+  std::vector<std::uint8_t> touches_floor;        // per particle (empty: none does)
+  double bore_radius_mm = 0.61;                   // the cylinder the edge cut along
+  double x_lo_mm = 0, x_hi_mm = 0;
+  std::optional<double> floor_y_mm;               // the groove's floor (none: no groove)
+};
+
+struct TissueSample {
+  std::int64_t particles = 0, floor_particles = 0;
+  double length_mm = 0, floor_length_mm = 0, floor_covered_mm = 0, volume_mm3 = 0, mass_g = 0;
+  double back_x_mm = 0, front_x_mm = 0;  // the captured tissue's extent (reference frame; 0 when empty)
+  std::vector<std::uint8_t> captured;    // per particle
+};
+
+TissueSample measure_tissue_sample(const TissueSampleInput& input);
+
+}  // namespace needle

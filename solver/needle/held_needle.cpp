@@ -1,0 +1,46 @@
+#include "solver/needle/held_needle.h"
+
+#include <nlohmann/json.hpp>
+
+#include "core/input_error.h"
+
+namespace needle {
+
+HeldNeedle::HeldNeedle(std::unique_ptr<NeedleModel> inner, double hold_from_ms) : inner_(std::move(inner)), hold_from_ms_(hold_from_ms) {
+  NEEDLE_REQUIRE(inner_ != nullptr, "held needle: no needle model to hold");
+  NEEDLE_REQUIRE(hold_from_ms >= 0, "held needle: the hold must start at t >= 0");
+}
+
+void HeldNeedle::hold() {
+  held_ = true;
+  time_ms_ = inner_->time_ms();
+  still_ = Eigen::MatrixX3d::Zero(inner_->positions_mm().rows(), 3);
+  energy_ = inner_->energy();
+  taken_mJ_ = energy_.kinetic_mJ;
+  energy_.held_mJ += taken_mJ_;  // the supports take the kinetic energy out
+  energy_.kinetic_mJ = 0;
+}
+
+void HeldNeedle::advance_to(double end_time_ms, NeedleLoads& loads) {
+  if (!held_) {
+    inner_->advance_to(std::min(end_time_ms, hold_from_ms_), loads);
+    if (inner_->time_ms() < hold_from_ms_ - 1e-12 * std::max(1.0, hold_from_ms_)) return;
+    hold();
+  }
+  if (end_time_ms <= time_ms_) return;
+  // The loads on the still needle, for the contact's account and the supports' reaction.
+  forces_.clear();
+  loads.needle_forces(inner_->positions_mm(), still_, end_time_ms, forces_);
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (const auto& [node, force] : forces_) sum += force;
+  reaction_N_ = -sum;
+  held_impulse_N_ms_ += (end_time_ms - time_ms_) * reaction_N_;
+  time_ms_ = end_time_ms;
+}
+
+void HeldNeedle::add_summary(nlohmann::json& summary) const {
+  inner_->add_summary(summary);
+  summary["needle_held"] = {{"from_ms", hold_from_ms_}, {"kinetic_energy_taken_mJ", taken_mJ_}};
+}
+
+}  // namespace needle
