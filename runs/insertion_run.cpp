@@ -204,7 +204,8 @@ class InsertionRunModel : public RunModel {
 
   void add_summary(json& summary, double) const override {
     const InsertionEnergy& e = run_->energy();
-    const GrooveFill groove = run_groove_fill(*run_, built_, scene_);
+    // The groove at the insertion's end (with a fired cannula, before it: the sample is its own entry).
+    const GrooveFill groove = at_insertion_end_ ? at_insertion_end_->groove : run_groove_fill(*run_, built_, scene_);
     summary["needle_steps"] = run_->needle_steps();
     // How many coupling steps each limit set (solver/insertion/coupled_insertion.h: StepLimit).
     json limits = json::object();
@@ -269,7 +270,6 @@ class InsertionRunModel : public RunModel {
     const TissueSample& sample = *sample_;
     const TissueSample& on_floor_at_end = *sample_on_floor_at_end_;
     const CannulaStroke& s = firing_->stroke();
-    const GrooveFill before = at_insertion_end_ ? at_insertion_end_->groove : GrooveFill{};
     summary["sample"] = {
         {"I_s_mm", sample.floor_length_mm},
         {"floor_length_mm", sample.floor_length_mm},
@@ -286,8 +286,6 @@ class InsertionRunModel : public RunModel {
                      {"start_x_mm", s.start_x_mm}, {"stop_x_mm", s.stop_x_mm}, {"front_x_mm_at_end", s.front_x_mm(run_->time_ms())},
                      {"bore_radius_mm", firing_->tube().inner_radius_mm}, {"outer_radius_mm", firing_->tube().outer_radius_mm},
                      {"wall_pushes", firing_->pushes()}, {"max_push_mm", firing_->max_push_mm()}, {"wall_work_mJ", firing_->work_mJ()}}},
-        {"groove_before_firing", {{"groove_fill", before.groove_fill}, {"floor_contact_fraction", before.floor_contact_fraction},
-                                  {"mean_gap_mm", before.mean_gap_mm}}},
         {"definition", "solver/insertion/tissue_sample.h: the particles inside the cannula's mid-wall radius, between the groove's walls within "
                        "the stroke, above the groove floor less half a spacing, in the needle's reference frame; I_s_mm is the extent along the "
                        "axis of those that touched the groove floor at a record during the stroke (floor_length_at_end_mm: touching it at the end); x in the needle's reference frame (tip point A at 0)"}};

@@ -14,6 +14,7 @@ RunOutcome run_outcome(const nlohmann::json& s) {
   o.max_energy_balance_error = number_or_nan(s, "max_energy_balance_error");
   o.max_penetration_mm = number_or_nan(s, "max_penetration_mm");
   if (s.contains("groove") && s["groove"].is_object()) o.groove_fill = number_or_nan(s["groove"], "groove_fill");
+  if (s.contains("sample") && s["sample"].is_object()) o.sample_I_s_mm = number_or_nan(s["sample"], "I_s_mm");
   o.particles_inside = s.value("particles_inside", 0L);
   o.steps = s.value("steps", 0L);
   return o;

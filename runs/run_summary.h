@@ -12,6 +12,7 @@ struct RunOutcome {
   double deflection_mm = std::nan(""), insertion_mm = std::nan(""), runtime_s = std::nan("");
   double max_energy_balance_error = std::nan(""), max_penetration_mm = std::nan("");
   double groove_fill = std::nan("");  // NaN without a groove
+  double sample_I_s_mm = std::nan("");  // the fired cannula's sample length (summary "sample"; NaN: no firing)
   long particles_inside = 0, steps = 0;
 };
 

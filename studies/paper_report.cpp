@@ -15,6 +15,7 @@
 #include "runs/provenance_json.h"
 #include "runs/run_summary.h"
 #include "studies/paper_observations.h"
+#include "studies/paper_sampling.h"
 #include "studies/run_model_description.h"
 #include "runs/scene.h"
 #include "runs/scene_key_spellings.h"
@@ -81,6 +82,7 @@ FittedParameter fitted_parameter(const PaperReportInput& in, const fs::path& dir
 struct NeedleRun : NeedleOutcome {
   std::string folder, reason;
   double runtime_s = kNaN, floor_contact_fraction = kNaN, mean_gap_mm = kNaN, max_energy_error = kNaN, max_penetration_mm = kNaN;
+  double sample_I_s_mm = kNaN, sample_length_mm = kNaN, sample_volume_mm3 = kNaN;  // a fired cannula's (summary "sample")
   long bonds_broken = 0, bonds_cut_by_needle = 0, particles_inside = 0, steps = 0, particles = 0;
   std::string model_description;  // from the run's scene.json: the particles, the needle's cut, the law and the drive where not the paper's
   bool needle_cuts = false;       // the scene's tissue.contact.cuts_bonds
@@ -112,6 +114,11 @@ NeedleRun read_run(const std::string& out_dir, const std::string& name) {
   if (s.contains("groove") && s["groove"].is_object()) {
     r.floor_contact_fraction = number_or_nan(s["groove"], "floor_contact_fraction");
     r.mean_gap_mm = number_or_nan(s["groove"], "mean_gap_mm");
+  }
+  if (s.contains("sample") && s["sample"].is_object()) {
+    r.sample_I_s_mm = number_or_nan(s["sample"], "I_s_mm");
+    r.sample_length_mm = number_or_nan(s["sample"], "length_mm");
+    r.sample_volume_mm3 = number_or_nan(s["sample"], "volume_mm3");
   }
   r.particles = s.value("particles", 0L);
   const fs::path scene_path = fs::path(r.folder) / "scene.json";
@@ -480,6 +487,15 @@ void write_paper_report(const PaperReportInput& in) {
                       order);
   }
   md += "\n![groove fill](groove_fill.png)\n\n";
+  {
+    std::vector<SampledNeedle> sampled;
+    for (const NeedleRun& r : runs) {
+      const PaperReferenceNeedle* ref = find_reference(in.reference, r.name);
+      sampled.push_back({r.name, r.sample_I_s_mm, r.sample_length_mm, r.sample_volume_mm3, r.floor_contact_fraction,
+                         ref ? ref->sample_length_mm : kNaN});
+    }
+    md += sampling_section(sampled, tissue);
+  }
   md += "## Forces on the facets, and why a needle bends the way it does\n\n";
   md += "The y force the tissue exerts on each part of the needle at the end of insertion (N, +: pushes it up). The tip's "
         "facets and the groove floor are the paper's levers of the bending moment (M_t and M_b). The shaft is the rod's round "

@@ -210,6 +210,12 @@ CaseResult case_record(int index, const std::string& name, const std::string& la
   return r;
 }
 
+std::string finished_case_words(const CaseResult& r) {
+  std::string words = fmt::format("deflection {:+.4f} mm, groove fill {:.3f}", r.deflection_mm, r.groove_fill);
+  if (std::isfinite(r.sample_I_s_mm)) words += fmt::format(", I_s {:.2f} mm", r.sample_I_s_mm);
+  return words;
+}
+
 json case_result_to_json(const CaseResult& r) {
   auto number = [](double x) { return std::isfinite(x) ? json(x) : json(nullptr); };
   json j{{"case", r.index},
@@ -227,6 +233,7 @@ json case_result_to_json(const CaseResult& r) {
               {"end_forces_N", r.end_forces_N},
               {"run_folder", r.run_folder}};
   if (!r.label.empty()) j["label"] = r.label;
+  if (std::isfinite(r.sample_I_s_mm)) j["sample_I_s_mm"] = r.sample_I_s_mm;  // only where the cannula was fired
   return j;
 }
 
@@ -240,6 +247,7 @@ CaseResult case_result_from_json(const json& j, const std::string& source) {
     r.reason = j.at("reason").get<std::string>();
     r.deflection_mm = number_or_nan(j, "deflection_mm");
     r.groove_fill = number_or_nan(j, "groove_fill");
+    r.sample_I_s_mm = number_or_nan(j, "sample_I_s_mm");
     r.insertion_mm = number_or_nan(j, "insertion_mm");
     r.runtime_s = number_or_nan(j, "runtime_s");
     r.max_energy_balance_error = number_or_nan(j, "max_energy_balance_error");
@@ -329,6 +337,7 @@ CaseResult run_design_case(const DesignBase& base, int index, const std::string&
   r.max_penetration_mm = o.max_penetration_mm;
   r.particles_inside = o.particles_inside;
   r.groove_fill = o.groove_fill;
+  r.sample_I_s_mm = o.sample_I_s_mm;
   const fs::path forces_file = dir / "run" / "facet_forces.csv";
   if (fs::exists(forces_file)) {
     const CsvTable forces = read_csv_table(forces_file.string());

@@ -68,6 +68,7 @@ struct CaseResult {
   std::string status = "pending", reason;
   double deflection_mm = std::nan(""), groove_fill = std::nan(""), insertion_mm = std::nan(""), runtime_s = std::nan("");
   double max_energy_balance_error = std::nan(""), max_penetration_mm = std::nan("");  // the run's worst
+  double sample_I_s_mm = std::nan("");  // the sample's length when the scene fires the cannula (NaN: it does not)
   long particles_inside = -1;                                                          // at the end (-1: not run)
   std::map<std::string, double> end_forces_N;  // facet_forces.csv's last row: each facet's fx, fy, normal and friction
   std::string run_folder;                     // relative to the study folder
@@ -75,6 +76,8 @@ struct CaseResult {
   bool done() const { return status == "finished" || status == "stopped" || status == "infeasible" || status == "timed_out"; }
 };
 nlohmann::json case_result_to_json(const CaseResult& result);
+// A finished case's responses in words for the progress lines: "deflection +0.1234 mm, groove fill 0.987[, I_s 12.3 mm]".
+std::string finished_case_words(const CaseResult& result);
 // The record of a case that ended without a run's result (timed out, failed, infeasible), with its reason.
 CaseResult case_record(int index, const std::string& name, const std::string& label, const nlohmann::json& values, const std::string& status,
                        const std::string& reason);

@@ -59,12 +59,20 @@ json problem_to_json(const OptimizationProblem& p) {
   j["variables"] = variables;
   j["objective"] = p.deflection_target ? json{{"deflection_target_mm", p.target_deflection_mm}} : json{{"minimize", "abs_deflection"}};
   if (std::isfinite(p.groove_fill_at_least)) j["objective"]["groove_fill_at_least"] = p.groove_fill_at_least;
+  if (std::isfinite(p.sample_length_at_least_mm)) j["objective"]["sample_length_at_least_mm"] = p.sample_length_at_least_mm;
   j["method"] = p.method;
   j["deflection_tolerance_mm"] = std::isfinite(p.deflection_tolerance_mm) ? json(p.deflection_tolerance_mm) : json(nullptr);
   return j;  // max_evaluations left out: a search may be given more evaluations and go on
 }
 
 }  // namespace
+
+double OptimizationProblem::shortfall(double groove_fill, double sample_I_s_mm) const {
+  double share = 0;
+  if (std::isfinite(groove_fill_at_least)) share += std::max(0.0, groove_fill_at_least - groove_fill);
+  if (std::isfinite(sample_length_at_least_mm)) share += std::max(0.0, (sample_length_at_least_mm - sample_I_s_mm) / sample_length_at_least_mm);
+  return share;
+}
 
 OptimizationProblem read_optimization_file(const std::string& path) {
   const JsonDocument doc = read_json_with_lines(path);
@@ -99,7 +107,7 @@ OptimizationProblem read_optimization_file(const std::string& path) {
                  fmt::format("{}: give 'objective': {{\"deflection_target_mm\": 0}} or {{\"minimize\": \"abs_deflection\", \"groove_fill_at_least\": 0.8}}",
                              doc.where("/objective")));
   const json& objective = v.at("objective");
-  refuse_unknown_keys(doc, objective, "/objective", {"deflection_target_mm", "minimize", "groove_fill_at_least"});
+  refuse_unknown_keys(doc, objective, "/objective", {"deflection_target_mm", "minimize", "groove_fill_at_least", "sample_length_at_least_mm"});
   NEEDLE_REQUIRE(objective.contains("deflection_target_mm") != objective.contains("minimize"),
                  fmt::format("{}: give one objective: deflection_target_mm or minimize", doc.where("/objective")));
   p.deflection_target = objective.contains("deflection_target_mm");
@@ -109,7 +117,10 @@ OptimizationProblem read_optimization_file(const std::string& path) {
   p.groove_fill_at_least = number_at(doc, objective, "groove_fill_at_least", "/objective", std::nan(""));
   NEEDLE_REQUIRE(std::isnan(p.groove_fill_at_least) || (p.groove_fill_at_least >= 0 && p.groove_fill_at_least <= 1),
                  fmt::format("{}: groove_fill_at_least is a share of the groove's depth, from 0 to 1", doc.where("/objective/groove_fill_at_least")));
-  const bool constrained = std::isfinite(p.groove_fill_at_least);
+  p.sample_length_at_least_mm = number_at(doc, objective, "sample_length_at_least_mm", "/objective", std::nan(""));
+  NEEDLE_REQUIRE(std::isnan(p.sample_length_at_least_mm) || p.sample_length_at_least_mm > 0,
+                 fmt::format("{}: sample_length_at_least_mm must be positive", doc.where("/objective/sample_length_at_least_mm")));
+  const bool constrained = p.constrained();
   // One variable toward a deflection target is a root: bracketed (TOMS 748) it converges however rough delta(d_a) is.
   const bool root = p.deflection_target && p.variables.size() == 1 && !constrained;
   p.method = v.contains("method") && v.at("method").is_string() ? v.at("method").get<std::string>() : (constrained ? "cobyla" : root ? "toms748" : "bobyqa");
@@ -119,7 +130,8 @@ OptimizationProblem read_optimization_file(const std::string& path) {
                  fmt::format("{}: toms748 finds where one variable makes the deflection its target: one variable, deflection_target_mm, no constraint",
                              doc.where("/method")));
   NEEDLE_REQUIRE(!constrained || p.method == "cobyla",
-                 fmt::format("{}: {} takes no constraint: groove_fill_at_least needs method cobyla", doc.where("/method"), p.method));
+                 fmt::format("{}: {} takes no constraint: a constraint (groove_fill_at_least, sample_length_at_least_mm) needs method cobyla",
+                             doc.where("/method"), p.method));
   p.max_evaluations = static_cast<int>(number_at(doc, v, "max_evaluations", "", 20));
   NEEDLE_REQUIRE(p.max_evaluations >= 1 && p.max_evaluations <= 1000 && number_at(doc, v, "max_evaluations", "", 20) == p.max_evaluations,
                  fmt::format("{}: max_evaluations must be a whole number from 1 to 1000", doc.where("/max_evaluations")));
@@ -145,6 +157,10 @@ OptimizationProblem read_optimization_file(const std::string& path) {
     } catch (const InputError& e) {
       throw InputError(fmt::format("{}: at {}: {}", path, describe_values(values), e.what()));
     }
+    NEEDLE_REQUIRE(std::isnan(p.sample_length_at_least_mm) || setup.scene.cannula_firing.enabled,
+                   fmt::format("{}: sample_length_at_least_mm needs the sample, which the runs take only when they fire the cannula: set "
+                               "\"cannula.firing.enabled\": true in \"set\" (or the base scene)",
+                               doc.where("/objective/sample_length_at_least_mm")));
     const std::string reason = tip_infeasibility(setup);
     NEEDLE_REQUIRE(reason.empty(), fmt::format("{}: the bounds take in a tip that cannot be ground, at {}: {}", doc.where("/variables"), describe_values(values), reason));
   }
@@ -161,7 +177,7 @@ OptimizationOutcome optimize_design(const OptimizationProblem& p, const fs::path
   OptimizationOutcome outcome;
   std::map<std::string, size_t> seen;  // the values' JSON -> evaluation
   std::string stop_reason;
-  const bool constrained = std::isfinite(p.groove_fill_at_least);
+  const bool constrained = p.constrained();
   InterruptWatch watch;
   auto evaluate = [&](const std::vector<double>& x) -> const CaseResult& {
     const json values = values_at(p.variables, x);
@@ -179,7 +195,7 @@ OptimizationOutcome optimize_design(const OptimizationProblem& p, const fs::path
     seen[values.dump()] = outcome.evaluations.size() - 1;
     if (!quiet)
       fmt::print(stderr, "optimize: {} ({}): {}{} in {:.0f} s\n", name, describe_values(values),
-                 r->status == "finished" ? fmt::format("deflection {:+.4f} mm, groove fill {:.3f}", r->deflection_mm, r->groove_fill)
+                 r->status == "finished" ? finished_case_words(*r)
                                          : fmt::format("{}: {}", r->status, r->reason),
                  reused ? " (done before: reused)" : "", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     return outcome.evaluations.back();
@@ -201,7 +217,11 @@ OptimizationOutcome optimize_design(const OptimizationProblem& p, const fs::path
     throw nlopt::forced_stop();
   };
   Callback objective = [&](const std::vector<double>& x) { return objective_of(finished_case(x)); };
-  Callback constraint = [&](const std::vector<double>& x) { return p.groove_fill_at_least - finished_case(x).groove_fill; };  // <= 0: fills enough
+  // <= 0: fills enough; takes a long enough sample.
+  Callback fill_constraint = [&](const std::vector<double>& x) { return p.groove_fill_at_least - finished_case(x).groove_fill; };
+  Callback sample_constraint = [&](const std::vector<double>& x) {
+    return (p.sample_length_at_least_mm - finished_case(x).sample_I_s_mm) / p.sample_length_at_least_mm;
+  };
   if (p.method == "toms748") {
     const OptimizedVariable& x = p.variables.front();
     const auto miss = [&](double at) {
@@ -238,7 +258,8 @@ OptimizationOutcome optimize_design(const OptimizationProblem& p, const fs::path
   opt.set_maxeval(p.max_evaluations);
   if (std::isfinite(p.deflection_tolerance_mm)) opt.set_stopval(p.deflection_tolerance_mm * p.deflection_tolerance_mm);
   opt.set_min_objective(trampoline, &objective);
-  if (constrained) opt.add_inequality_constraint(trampoline, &constraint, 1e-3);
+  if (std::isfinite(p.groove_fill_at_least)) opt.add_inequality_constraint(trampoline, &fill_constraint, 1e-3);
+  if (std::isfinite(p.sample_length_at_least_mm)) opt.add_inequality_constraint(trampoline, &sample_constraint, 1e-3);
   double value = 0;
   try {
     if (p.method == "toms748") throw nlopt::forced_stop();  // done above
@@ -256,7 +277,7 @@ OptimizationOutcome optimize_design(const OptimizationProblem& p, const fs::path
   for (size_t k = 0; k < outcome.evaluations.size(); ++k) {
     const CaseResult& r = outcome.evaluations[k];
     if (r.status != "finished") continue;
-    const double violation = constrained ? std::max(0.0, p.groove_fill_at_least - r.groove_fill) : 0.0;
+    const double violation = constrained ? p.shortfall(r.groove_fill, r.sample_I_s_mm) : 0.0;
     const double f = objective_of(r);
     if (violation < best_violation || (violation == best_violation && f < best_objective)) {
       best_violation = violation;
@@ -269,13 +290,14 @@ OptimizationOutcome optimize_design(const OptimizationProblem& p, const fs::path
     std::ofstream out(scratch);
     out << "evaluation,name";
     for (const OptimizedVariable& v : p.variables) out << "," << v.name;
-    out << ",status,deflection_mm,groove_fill,objective,runtime_s\n";
+    const bool sampled = std::isfinite(p.sample_length_at_least_mm);
+    out << ",status,deflection_mm,groove_fill" << (sampled ? ",sample_I_s_mm" : "") << ",objective,runtime_s\n";
     for (const CaseResult& r : outcome.evaluations) {
       out << r.index << "," << r.name;
       for (const OptimizedVariable& v : p.variables) out << "," << fmt::format("{}", r.values.at(v.name).get<double>());
       const bool ok = r.status == "finished";
       out << "," << r.status << "," << (ok ? fmt::format("{}", r.deflection_mm) : "") << "," << (ok ? fmt::format("{}", r.groove_fill) : "")
-          << "," << (ok ? fmt::format("{}", objective_of(r)) : "") << "," << (std::isfinite(r.runtime_s) ? fmt::format("{:.3f}", r.runtime_s) : "") << "\n";
+          << (sampled ? "," + (ok ? fmt::format("{}", r.sample_I_s_mm) : std::string()) : std::string()) << "," << (ok ? fmt::format("{}", objective_of(r)) : "") << "," << (std::isfinite(r.runtime_s) ? fmt::format("{:.3f}", r.runtime_s) : "") << "\n";
     }
   });
   json optimum{{"problem", p.source},
@@ -288,7 +310,8 @@ OptimizationOutcome optimize_design(const OptimizationProblem& p, const fs::path
     const CaseResult& best = outcome.evaluations[static_cast<size_t>(outcome.best)];
     optimum["best"] = case_result_to_json(best);
     optimum["best"]["objective"] = objective_of(best);
-    if (constrained) optimum["best"]["meets_groove_fill"] = best.groove_fill >= p.groove_fill_at_least;
+    if (std::isfinite(p.groove_fill_at_least)) optimum["best"]["meets_groove_fill"] = best.groove_fill >= p.groove_fill_at_least;
+    if (std::isfinite(p.sample_length_at_least_mm)) optimum["best"]["meets_sample_length"] = best.sample_I_s_mm >= p.sample_length_at_least_mm;
     const std::optional<GrindingRecipe> recipe = case_recipe(case_setup(p.base, best.values));
     if (recipe) {
       write_file_atomically((dir / "best_recipe.json").string(),

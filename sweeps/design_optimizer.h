@@ -28,6 +28,11 @@ struct OptimizationProblem {
   bool deflection_target = true;       // false: minimise |delta|
   double target_deflection_mm = 0;
   double groove_fill_at_least = std::nan("");  // a constraint (NaN: none)
+  double sample_length_at_least_mm = std::nan("");  // a constraint on the fired cannula's sample length I_s (NaN: none)
+  bool constrained() const { return std::isfinite(groove_fill_at_least) || std::isfinite(sample_length_at_least_mm); }
+  // How far a finished case falls short of the constraints (0: it meets them): the sum of each one's shortfall as a share
+  // of its bound (the groove fill's is a share of the groove's depth already).
+  double shortfall(double groove_fill, double sample_I_s_mm) const;
   double deflection_tolerance_mm = std::nan("");  // stop once |delta - target| is below (NaN: on the variables' tolerances alone)
   std::string method;                  // toms748 (one variable, a deflection target), bobyqa, cobyla, neldermead, sbplx
   int max_evaluations = 20;

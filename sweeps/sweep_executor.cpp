@@ -92,7 +92,7 @@ void SweepProgress::case_done(const CaseResult& r, double wall_s) {
   if (quiet_) return;
   const int left = total_ - done_;
   const double eta_s = left * (case_seconds_ / done_here_) / workers_;
-  const std::string outcome = r.status == "finished" ? fmt::format("deflection {:+.4f} mm, groove fill {:.3f}", r.deflection_mm, r.groove_fill)
+  const std::string outcome = r.status == "finished" ? finished_case_words(r)
                                                      : r.reason;
   fmt::print(stderr, "sweep: {} {} in {:.0f} s ({}): {} | {} of {} done, {} failed, ETA {}\n", r.name, r.status, wall_s, describe_case(r.label, r.values),
              outcome, done_, total_, failed_, left == 0 ? "0 s" : duration_words(eta_s));

@@ -79,11 +79,12 @@ void plot_against(const fs::path& dir, const std::string& variable, const std::v
   constexpr size_t kMaxCurves = 8;
   LinePlot deflection{fmt::format("Tip deflection at the end of the insertion against {}", variable), variable, "deflection (mm)", {}};
   LinePlot fill{fmt::format("Groove fill at the end of the insertion against {}", variable), variable, "groove fill (share of the depth)", {}};
+  LinePlot sample{fmt::format("The fired cannula's sample length I_s against {}", variable), variable, "I_s (mm)", {}};
   for (size_t k = 0; k < curves.size() && k < kMaxCurves; ++k) {
     const std::string label = curves.size() == 1 ? "this toolkit" : describe_values(curves[k].first);
     PlotSeries d{label, {}, {}, plot_color(static_cast<int>(k))};
     d.markers = true;
-    PlotSeries f = d;
+    PlotSeries f = d, s = d;
     for (const CaseResult* r : curves[k].second) {
       const double x = r->values.at(variable).get<double>();
       const bool ok = r->status == "finished";
@@ -91,12 +92,18 @@ void plot_against(const fs::path& dir, const std::string& variable, const std::v
       d.y.push_back(ok ? r->deflection_mm : std::nan(""));
       f.x.push_back(x);
       f.y.push_back(ok ? r->groove_fill : std::nan(""));
+      s.x.push_back(x);
+      s.y.push_back(ok ? r->sample_I_s_mm : std::nan(""));
     }
     deflection.series.push_back(d);
     fill.series.push_back(f);
+    sample.series.push_back(s);
   }
   if (variable == "d_a_mm" && !reference_file.empty() && fs::exists(reference_file)) {
     PlotSeries experiment{"the paper's experiment (SB, LMB, AMB, HMB)", {}, {}, kExperiment};
+    PlotSeries measured_sample{"the paper's experiment (chicken breast)", {}, {}, kExperiment};
+    measured_sample.line = false;
+    measured_sample.markers = true;
     PlotSeries lsdyna{"the paper's LS-DYNA model", {}, {}, kLsDyna};
     experiment.line = lsdyna.line = false;
     experiment.markers = lsdyna.markers = true;
@@ -106,12 +113,20 @@ void plot_against(const fs::path& dir, const std::string& variable, const std::v
       experiment.y.push_back(n.deflection_experiment_mm);
       lsdyna.x.push_back(n.d_a_mm);
       lsdyna.y.push_back(n.deflection_lsdyna_mm);
+      if (std::isfinite(n.sample_length_mm)) {
+        measured_sample.x.push_back(n.d_a_mm);
+        measured_sample.y.push_back(n.sample_length_mm);
+      }
     }
+    sample.series.push_back(measured_sample);
     deflection.series.push_back(experiment);
     deflection.series.push_back(lsdyna);
   }
   write_plot(dir / fmt::format("deflection_vs_{}.png", variable), deflection);
   write_plot(dir / fmt::format("groove_fill_vs_{}.png", variable), fill);
+  // Only where a case fired the cannula (write_plot draws nothing without a finite point of this toolkit's).
+  if (std::any_of(rows.begin(), rows.end(), [](const CaseResult& r) { return std::isfinite(r.sample_I_s_mm); }))
+    write_plot(dir / fmt::format("sample_length_vs_{}.png", variable), sample);
 }
 
 // Maps of deflection and groove fill over a grid of two numeric variables (x the first, y the second).
@@ -207,20 +222,24 @@ SweepCounts count_cases(const std::vector<CaseResult>& rows) {
 
 void write_sweep_table(const fs::path& dir, const SweepPlan& plan, const std::vector<CaseResult>& rows, const std::string& reference_file) {
   std::set<std::string> force_columns;
-  for (const CaseResult& r : rows)
+  bool sampled = false;  // a case fired the cannula: the sample's length is a column
+  for (const CaseResult& r : rows) {
     for (const auto& [column, value] : r.end_forces_N) force_columns.insert(column);
+    sampled = sampled || std::isfinite(r.sample_I_s_mm);
+  }
   write_file_atomically((dir / "sweep.csv").string(), [&](const std::string& scratch) {
     std::ofstream out(scratch);
     out << "case,name";
     for (const std::string& v : plan.variables) out << "," << csv_field(v);
-    out << ",label,status,deflection_mm,groove_fill,insertion_mm,runtime_s,max_energy_balance_error,max_penetration_mm,particles_inside";
+    out << ",label,status,deflection_mm,groove_fill" << (sampled ? ",sample_I_s_mm" : "")
+        << ",insertion_mm,runtime_s,max_energy_balance_error,max_penetration_mm,particles_inside";
     for (const std::string& f : force_columns) out << ",end_" << f;
     out << ",run_folder,reason\n";
     for (const CaseResult& r : rows) {
       out << r.index << "," << r.name;
       for (const std::string& v : plan.variables) out << "," << (r.values.contains(v) ? value_field(r.values.at(v)) : "");
       out << "," << csv_field(r.label) << "," << r.status << "," << number_field(r.deflection_mm) << "," << number_field(r.groove_fill) << ","
-          << number_field(r.insertion_mm) << "," << number_field(r.runtime_s) << "," << number_field(r.max_energy_balance_error) << ","
+          << (sampled ? number_field(r.sample_I_s_mm) + "," : "") << number_field(r.insertion_mm) << "," << number_field(r.runtime_s) << "," << number_field(r.max_energy_balance_error) << ","
           << number_field(r.max_penetration_mm) << "," << (r.particles_inside >= 0 ? std::to_string(r.particles_inside) : "");
       for (const std::string& f : force_columns) out << "," << (r.end_forces_N.count(f) ? number_field(r.end_forces_N.at(f)) : "");
       out << "," << csv_field(r.run_folder) << "," << csv_field(r.reason) << "\n";

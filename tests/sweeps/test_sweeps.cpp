@@ -403,6 +403,10 @@ TEST_CASE("Bad sweep and optimisation files get one clear error before any case 
        "cannot be ground"},
       {R"({"base": {"scene": "scene.json"}, "variables": {"d_a_mm": {"min": -0.3, "max": 0.3}}, "objective": {"minimize": "abs_deflection", "groove_fill_at_least": 0.5}, "method": "bobyqa"})",
        "needs method cobyla"},
+      {R"({"base": {"scene": "scene.json"}, "variables": {"d_a_mm": {"min": -0.3, "max": 0.3}}, "objective": {"minimize": "abs_deflection", "sample_length_at_least_mm": 5}})",
+       "sample_length_at_least_mm needs the sample, which the runs take only when they fire the cannula"},
+      {R"({"base": {"scene": "scene.json"}, "set": {"cannula.firing.enabled": true}, "variables": {"d_a_mm": {"min": -0.3, "max": 0.3}}, "objective": {"minimize": "abs_deflection", "sample_length_at_least_mm": -1}})",
+       "sample_length_at_least_mm must be positive"},
       {R"({"base": {"scene": "scene.json"}, "variables": {"d_a_mm": {"min": -0.3, "max": 0.3, "start": 0.5}}, "objective": {"deflection_target_mm": 0}})",
        "outside"},
   };
@@ -509,6 +513,44 @@ TEST_CASE("needle optimize reaches a deflection target and resumes from its eval
       CHECK(f["tilt_deg"].get<double>() == 20.0);
     }
   CHECK(top_facets == 1);
+}
+
+TEST_CASE("A sweep with the cannula fired tabulates and plots the sample's length, a search takes it as a constraint",
+          "[sweeps][gmsh][lspg][cannula][slow]") {
+  // The tiny scene pushed 4.2 mm, so that 1.2 mm of the groove (3 mm behind tip point A) lies in the tissue, with the
+  // cannula fired: two d_a in a sweep, then a search for the smallest |delta| whose sample is at least 0.4 mm long.
+  const fs::path dir = fresh_folder("sweep_sample");
+  write(dir / "scene.json", R"({"needle": {"d_a_mm": 0, "length_mm": 26, "mesh": {"order": 1, "size_mm": 0.5}},)"
+                            R"("motion": {"accel_time_ms": 0.02, "travel_mm": 4.2}, "cannula": {"enabled": false, "firing": {"enabled": true}},)"
+                            R"("tissue": {"enabled": true, "size_mm": [5, 2.4, 1.2], "spacing_mm": 0.4}, "output": {"frames": 0}})");
+  write(dir / "sweep.json", R"({"base": {"scene": "scene.json"}, "model": "fast", "variables": {"d_a_mm": [-0.3, 0.3]}})");
+  const Result sweep = run("sweep " + (dir / "sweep.json").string() + " --out " + (dir / "sweep").string(), true);
+  INFO(sweep.out);
+  REQUIRE(sweep.exit_code == 0);
+  CHECK(sweep.out.find("I_s") != std::string::npos);  // the progress lines say it
+  const needle::CsvTable table = needle::read_csv_table((dir / "sweep" / "sweep.csv").string());
+  REQUIRE(table.rows.size() == 2);
+  for (size_t k = 0; k < 2; ++k) {
+    const json summary = read_json(dir / "sweep" / "cases" / fmt::format("case_{:04d}", k) / "run" / "summary.json");
+    CHECK(table.rows[k][table.index("sample_I_s_mm")] == summary["sample"]["I_s_mm"].get<double>());
+  }
+  CHECK(fs::exists(dir / "sweep" / "sample_length_vs_d_a_mm.png"));
+
+  write(dir / "search.json", R"({"base": {"scene": "scene.json"}, "model": "fast",)"
+                             R"("variables": {"d_a_mm": {"min": -0.3, "max": 0.3, "start": 0.0, "step": 0.2, "tolerance": 0.02}},)"
+                             R"("objective": {"minimize": "abs_deflection", "sample_length_at_least_mm": 0.4}, "max_evaluations": 4})");
+  const Result search = run("optimize " + (dir / "search.json").string() + " --out " + (dir / "search").string(), true);
+  INFO(search.out);
+  REQUIRE(search.exit_code == 0);
+  const json optimum = read_json(dir / "search" / "optimum.json");
+  CHECK(optimum["method"] == "cobyla");
+  REQUIRE(optimum.contains("best"));
+  const double best_I_s = optimum["best"]["sample_I_s_mm"].get<double>();
+  CHECK(optimum["best"]["meets_sample_length"] == (best_I_s >= 0.4));
+  const needle::CsvTable evaluations = needle::read_csv_table((dir / "search" / "evaluations.csv").string());
+  CHECK_NOTHROW(evaluations.index("sample_I_s_mm"));
+  const Result tip = run("tip --recipe " + (dir / "search" / "best_recipe.json").string() + " --json");
+  CHECK(tip.exit_code == 0);
 }
 
 TEST_CASE("Explicit cases set only their own variables and keep their labels", "[sweeps]") {
