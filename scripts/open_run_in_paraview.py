@@ -24,6 +24,7 @@ FIELDS = {
     "plastic_strain": "plastic strain",
     "broken_bonds": "broken bonds",
     "in_contact": "in contact with the needle",
+    "in_cannula": "in the fired cannula's bore",
 }
 
 
@@ -59,6 +60,8 @@ def main():
             summary = json.load(f)
     except (OSError, ValueError):
         pass  # an interrupted run may have none; the view still opens
+    if args.field == "in_cannula" and summary and "sample" not in summary:
+        fail(f"'{args.run}' did not fire the cannula: no in_cannula to colour by (needle run --fire-cannula writes it)")
 
     from paraview import simple as pv  # imported here so that --help and bad input need no ParaView
 
@@ -115,6 +118,9 @@ def main():
         words.append(f"{summary.get('needle', 'needle')}: {summary.get('status', '?')}")
         if isinstance(summary.get("deflection_mm"), (int, float)):
             words.append(f"tip deflection {summary['deflection_mm']:+.3f} mm at {summary.get('insertion_mm', 0):.1f} mm")
+        sample = summary.get("sample")
+        if isinstance(sample, dict) and isinstance(sample.get("I_s_mm"), (int, float)):
+            words.append(f"sample I_s {sample['I_s_mm']:.2f} mm, {sample.get('volume_mm3', 0):.2f} mm3")
         if summary.get("reason"):
             words.append(str(summary["reason"]))
     words.append(f"t = {last:.4g} ms")
