@@ -160,6 +160,12 @@ class InsertionRunModel : public RunModel {
     const double insertion_end = scene_.motion.end_time_ms();
     run_->step(time_ms() < insertion_end - 1e-12 ? std::min(end_time_ms, insertion_end) : end_time_ms);
     if (!at_insertion_end_ && time_ms() >= insertion_end - 1e-12) {
+      // The held needle takes no coupling: the tissue steps at the firing's own mass-scaled step.
+      if (const TissueMassScaling* scaling = run_->tissue_dynamics().mass_scaling()) {
+        const double target = scene_.cannula_firing.tissue_mass_scaling_dt_ms;
+        insertion_mass_scaling_dt_ms_ = scaling->target_dt_ms();
+        run_->tissue_dynamics().retarget_mass_scaling(target > 0 ? target : CannulaFiringOptions::kMassScalingGrowth * scaling->target_dt_ms());
+      }
       at_insertion_end_ = InsertionEnd{tip_displacement_now(), needle_model_->drive_displacement_mm(), run_groove_fill(*run_, built_, scene_),
                                        strain_probes_json(run_strain_probes(*run_, built_, scene_), needle_model_->drive_displacement_mm().norm(),
                                                           deflection_now())};
@@ -238,7 +244,8 @@ class InsertionRunModel : public RunModel {
     needle_model_->add_summary(summary);
     if (const TissueMassScaling* scaling = run_->tissue_dynamics().mass_scaling()) {
       const MassScalingReport& r = scaling->report();
-      summary["tissue_mass_scaling"] = {{"target_dt_ms", scaling->target_dt_ms()},
+      // The insertion's target (a fired cannula's stroke takes its own: the sample's entry).
+      summary["tissue_mass_scaling"] = {{"target_dt_ms", insertion_mass_scaling_dt_ms_ > 0 ? insertion_mass_scaling_dt_ms_ : scaling->target_dt_ms()},
                                         {"max_added_mass_percent", 100 * r.max_added_mass_g / scaling->physical_mass_g()},
                                         {"added_mass_percent_at_end", 100 * r.added_mass_g / scaling->physical_mass_g()},
                                         {"max_mass_ratio", r.max_ratio},
@@ -285,6 +292,7 @@ class InsertionRunModel : public RunModel {
         {"cannula", {{"speed_m_per_s", s.speed_mm_per_ms}, {"start_time_ms", s.start_time_ms}, {"end_time_ms", s.end_time_ms()},
                      {"start_x_mm", s.start_x_mm}, {"stop_x_mm", s.stop_x_mm}, {"front_x_mm_at_end", s.front_x_mm(run_->time_ms())},
                      {"bore_radius_mm", firing_->tube().inner_radius_mm}, {"outer_radius_mm", firing_->tube().outer_radius_mm},
+                     {"tissue_mass_scaling_dt_ms", run_->tissue_dynamics().mass_scaling() ? run_->tissue_dynamics().mass_scaling()->target_dt_ms() : 0.0},
                      {"wall_pushes", firing_->pushes()}, {"max_push_mm", firing_->max_push_mm()}, {"wall_work_mJ", firing_->work_mJ()}}},
         {"definition", "solver/insertion/tissue_sample.h: the particles inside the cannula's mid-wall radius, between the groove's walls within "
                        "the stroke, above the groove floor less half a spacing, in the needle's reference frame; I_s_mm is the extent along the "
@@ -325,6 +333,7 @@ class InsertionRunModel : public RunModel {
   };
   std::optional<InsertionEnd> at_insertion_end_;
   std::vector<std::uint8_t> touched_floor_;  // per particle: touched the groove floor at a record during the stroke
+  double insertion_mass_scaling_dt_ms_ = 0;  // the tissue's mass scaling target before a firing retargeted it (0: none did)
   std::optional<TissueSample> sample_, sample_on_floor_at_end_;  // at the run's end (close_outputs)
   int tip_ = 0;
   double setup_s_ = 0;

@@ -119,6 +119,7 @@ void read_cannula_firing(SceneObject o, CannulaFiringOptions& f) {
   f.dwell_ms = o.quantity("dwell", Dimension::time, f.dwell_ms, non_negative());
   f.lead_in_mm = o.quantity("lead_in", Dimension::length, f.lead_in_mm, non_negative());
   f.edge_taper_mm = o.quantity("edge_taper", Dimension::length, f.edge_taper_mm, non_negative());
+  f.tissue_mass_scaling_dt_ms = o.quantity("tissue_mass_scaling_dt", Dimension::time, f.tissue_mass_scaling_dt_ms, non_negative());
   o.finish();
 }
 
@@ -480,6 +481,7 @@ json scene_to_json(const Scene& s) {
     cannula["firing"] = {{"enabled", true},          {"speed_m_per_s", f.speed_mm_per_ms}, {"dwell_ms", f.dwell_ms},
                          {"lead_in_mm", f.lead_in_mm}, {"edge_taper_mm", f.edge_taper_mm}};
     if (!std::isnan(f.throw_mm)) cannula["firing"]["throw_mm"] = f.throw_mm;  // absent: to the groove's far end
+    cannula["firing"]["tissue_mass_scaling_dt_ms"] = f.tissue_mass_scaling_dt_ms;
   }
   return {
       {"needle", needle},

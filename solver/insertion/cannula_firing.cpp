@@ -14,6 +14,8 @@ void CannulaFiringOptions::validate(const std::string& where) const {
                  fmt::format("{}: throw_mm must be positive, or left out for the groove's far end (got {})", where, throw_mm));
   NEEDLE_REQUIRE(std::isfinite(dwell_ms) && dwell_ms >= 0, fmt::format("{}: dwell_ms must be zero or positive (got {})", where, dwell_ms));
   NEEDLE_REQUIRE(std::isfinite(lead_in_mm) && lead_in_mm >= 0, fmt::format("{}: lead_in_mm must be zero or positive (got {})", where, lead_in_mm));
+  NEEDLE_REQUIRE(std::isfinite(tissue_mass_scaling_dt_ms) && tissue_mass_scaling_dt_ms >= 0,
+                 fmt::format("{}: tissue_mass_scaling_dt_ms must be zero (the insertion's) or positive (got {})", where, tissue_mass_scaling_dt_ms));
   NEEDLE_REQUIRE(std::isfinite(edge_taper_mm) && edge_taper_mm >= 0,
                  fmt::format("{}: edge_taper_mm must be zero or positive (got {})", where, edge_taper_mm));
 }

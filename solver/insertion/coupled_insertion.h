@@ -113,6 +113,7 @@ class CoupledInsertion {
   const NeedleModel& needle() const { return needle_; }
   const SpgTissue& tissue() const { return tissue_; }
   const TissueDynamics& tissue_dynamics() const { return tissue_dynamics_; }
+  TissueDynamics& tissue_dynamics() { return tissue_dynamics_; }
 
  private:
   double plan_time_step(double end_time_ms, StepLimit& limit) const;

@@ -127,6 +127,12 @@ void TissueDynamics::set_mass_scaling(double target_dt_ms) {
   mass_scaling_ = target_dt_ms > 0 ? std::make_unique<TissueMassScaling>(target_dt_ms, tissue_.particles()) : nullptr;
 }
 
+void TissueDynamics::retarget_mass_scaling(double target_dt_ms) {
+  NEEDLE_REQUIRE(mass_scaling_ != nullptr, "the tissue's mass scaling is retargeted only where there is one");
+  NEEDLE_REQUIRE(!drifted_, "the tissue's mass scaling is retargeted between steps");
+  mass_scaling_->set_target_dt_ms(target_dt_ms);
+}
+
 void TissueDynamics::set_rate_levels(int max_level, double safety) {
   NEEDLE_REQUIRE(steps_ == 0 && !drifted_, "the tissue's rate levels are set before the first step");
   rate_levels_ = max_level > 0 ? std::make_unique<TissueRateLevels>(max_level, safety) : nullptr;

@@ -62,6 +62,8 @@ class TissueDynamics {
   // Selective mass scaling to this step (tissue_mass_scaling.h), before the first step; 0: none.
   void set_mass_scaling(double target_dt_ms);
   const TissueMassScaling* mass_scaling() const { return mass_scaling_.get(); }
+  // A new target for the mass scaling there is, between steps (a multi-rate cycle under way keeps its base step).
+  void retarget_mass_scaling(double target_dt_ms);
   // Multi-rate stepping (tissue_rate_levels.h) with this many levels above the base step, before the first step;
   // 0: one rate. The forces and force_N are then impulse-weighted (spg_tissue.h).
   void set_rate_levels(int max_level, double safety = 1.0);

@@ -15,6 +15,12 @@ TissueMassScaling::TissueMassScaling(double target_dt_ms, const TissueParticles&
   for (double m : physical_mass_g_) physical_mass_total_g_ += m;
 }
 
+void TissueMassScaling::set_target_dt_ms(double target_dt_ms) {
+  NEEDLE_REQUIRE(std::isfinite(target_dt_ms) && target_dt_ms > 0,
+                 fmt::format("the tissue's mass scaling step must be positive (got {} ms)", target_dt_ms));
+  target_dt_ms_ = target_dt_ms;
+}
+
 double TissueMassScaling::time_step_ms(double unscaled_stable_dt_ms) const { return std::max(target_dt_ms_, unscaled_stable_dt_ms); }
 
 const std::vector<std::int32_t>& TissueMassScaling::apply(double dt_ms, const SpgTissue& tissue, TissueParticles& p,

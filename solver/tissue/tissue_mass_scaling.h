@@ -37,6 +37,8 @@ class TissueMassScaling {
   TissueMassScaling(double target_dt_ms, const TissueParticles& particles);
 
   double target_dt_ms() const { return target_dt_ms_; }
+  // A new target from the next step on (the masses are set anew each step from it).
+  void set_target_dt_ms(double target_dt_ms);
   // The step the tissue may take given its own unscaled stable step: the larger of the two.
   double time_step_ms(double unscaled_stable_dt_ms) const;
   // Sets the masses for a step of dt_ms from the particles' own steps (SpgTissue::particle_time_steps_ms),
