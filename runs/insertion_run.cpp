@@ -174,8 +174,8 @@ class InsertionRunModel : public RunModel {
   void open_outputs(const RunFolder& folder) override { output_ = std::make_unique<InsertionOutput>(folder, *surface_, run_->separations()); }
   void record() override {
     output_->record(*run_, tip_, run_groove_fill(*run_, built_, scene_));
-    // Over the stroke, which particles touched the groove floor: the sample's I_s counts the tissue on the floor as the
-    // edge cut it, which may lift off once cut free.
+    // Over the stroke, which particles touched the groove floor (the tissue cut free may lift off it by the stop): the
+    // sample's floor_length_during_stroke_mm, beside I_s at the stop.
     if (firing_ && firing_->active(time_ms())) {
       const std::vector<std::uint8_t> now = groove_floor_contacts(*run_);
       if (touched_floor_.empty()) touched_floor_.assign(now.size(), 0);
@@ -190,11 +190,12 @@ class InsertionRunModel : public RunModel {
   void close_outputs(const RunFolder& folder) override {
     output_->finish();
     if (!firing_) return;
-    // The sample as the stroke leaves it, and its picture.
-    const std::vector<std::uint8_t> touched = touched_floor_.empty() ? groove_floor_contacts(*run_) : touched_floor_;
-    sample_ = run_tissue_sample(*run_, built_, *firing_, touched);
-    sample_on_floor_at_end_ = run_tissue_sample(*run_, built_, *firing_, groove_floor_contacts(*run_));
-    SamplePictureInput picture{firing_->reference_points(run_->tissue().particles().position_mm, needle_model_->positions_mm()), touched, *sample_,
+    // The sample as the stroke leaves it (on the floor at the stop, as the issue defines I_s; and on it at any record
+    // during the stroke), and its picture.
+    const std::vector<std::uint8_t> on_floor = groove_floor_contacts(*run_);
+    sample_ = run_tissue_sample(*run_, built_, *firing_, on_floor);
+    sample_touched_during_stroke_ = run_tissue_sample(*run_, built_, *firing_, touched_floor_.empty() ? on_floor : touched_floor_);
+    SamplePictureInput picture{firing_->reference_points(run_->tissue().particles().position_mm, needle_model_->positions_mm()), on_floor, *sample_,
                                *built_.groove, built_.radius_mm, firing_->tube()};
     write_png(draw_sample_picture(picture), folder.path("sample.png").string());
   }
@@ -275,13 +276,13 @@ class InsertionRunModel : public RunModel {
   void add_sample_summary(json& summary) const {
     if (!sample_) return;  // the run stopped before its outputs were closed
     const TissueSample& sample = *sample_;
-    const TissueSample& on_floor_at_end = *sample_on_floor_at_end_;
+    const TissueSample& touched_during_stroke = *sample_touched_during_stroke_;
     const CannulaStroke& s = firing_->stroke();
     summary["sample"] = {
         {"I_s_mm", sample.floor_length_mm},
         {"floor_length_mm", sample.floor_length_mm},
         {"floor_covered_mm", sample.floor_covered_mm},
-        {"floor_length_at_end_mm", on_floor_at_end.floor_length_mm},
+        {"floor_length_during_stroke_mm", touched_during_stroke.floor_length_mm},
         {"length_mm", sample.length_mm},
         {"volume_mm3", sample.volume_mm3},
         {"mass_g", sample.mass_g},
@@ -295,8 +296,9 @@ class InsertionRunModel : public RunModel {
                      {"tissue_mass_scaling_dt_ms", run_->tissue_dynamics().mass_scaling() ? run_->tissue_dynamics().mass_scaling()->target_dt_ms() : 0.0},
                      {"wall_pushes", firing_->pushes()}, {"max_push_mm", firing_->max_push_mm()}, {"wall_work_mJ", firing_->work_mJ()}}},
         {"definition", "solver/insertion/tissue_sample.h: the particles inside the cannula's mid-wall radius, between the groove's walls within "
-                       "the stroke, above the groove floor less half a spacing, in the needle's reference frame; I_s_mm is the extent along the "
-                       "axis of those that touched the groove floor at a record during the stroke (floor_length_at_end_mm: touching it at the end); x in the needle's reference frame (tip point A at 0)"}};
+                       "the stroke, above the groove floor less half a spacing, when the cannula stops, in the needle's reference frame; I_s_mm is "
+                       "the extent along the axis of those touching the groove floor then (floor_length_during_stroke_mm: of those that "
+                       "touched it at any record during the stroke); x in the needle's reference frame (tip point A at 0)"}};
   }
   std::string log_steps(double solve_s) const override {
     return fmt::format("{} coupling steps and {} needle steps in {:.2f} s, energy balance error {:.3g}, max penetration {:.3g} mm, {} particles "
@@ -334,7 +336,7 @@ class InsertionRunModel : public RunModel {
   std::optional<InsertionEnd> at_insertion_end_;
   std::vector<std::uint8_t> touched_floor_;  // per particle: touched the groove floor at a record during the stroke
   double insertion_mass_scaling_dt_ms_ = 0;  // the tissue's mass scaling target before a firing retargeted it (0: none did)
-  std::optional<TissueSample> sample_, sample_on_floor_at_end_;  // at the run's end (close_outputs)
+  std::optional<TissueSample> sample_, sample_touched_during_stroke_;  // at the run's end (close_outputs)
   int tip_ = 0;
   double setup_s_ = 0;
   std::unique_ptr<InsertionOutput> output_;

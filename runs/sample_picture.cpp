@@ -10,7 +10,7 @@ namespace needle {
 RgbImage draw_sample_picture(const SamplePictureInput& in) {
   constexpr double kNearPlaneMm = 0.3;  // the tissue left outside is drawn within this of the symmetry plane
   const GrooveBox& g = in.groove;
-  PlotSeries on_floor{"sample, touched the floor", {}, {}, {214, 39, 40}, false, true, false};
+  PlotSeries on_floor{"sample, on the floor", {}, {}, {214, 39, 40}, false, true, false};
   PlotSeries captured{"sample", {}, {}, {255, 127, 14}, false, true, false};
   PlotSeries outside{"tissue left outside (|z| < 0.3 mm)", {}, {}, {170, 170, 170}, false, true, false};
   for (size_t i = 0; i < in.reference_points.size(); ++i) {
@@ -27,7 +27,7 @@ RgbImage draw_sample_picture(const SamplePictureInput& in) {
   }
   const double lo = g.back_x_mm - 1, hi = g.front_x_mm + 1;
   LinePlot plot;
-  plot.title = fmt::format("The sample: I_s {:.2f} mm (touched the floor), {:.2f} mm in all, {:.3f} mm3", in.sample.floor_length_mm,
+  plot.title = fmt::format("The sample: I_s {:.2f} mm (on the floor), {:.2f} mm in all, {:.3f} mm3", in.sample.floor_length_mm,
                            in.sample.length_mm, in.sample.volume_mm3);
   plot.x_label = "x along the needle (mm; tip point A at 0)";
   plot.y_label = "y (mm)";

@@ -42,18 +42,20 @@ std::string sampling_section(const std::vector<SampledNeedle>& needles, const st
   std::string md = "## The sample: the cannula fired over the groove\n\n";
   md += fmt::format(
       "Each run fired the cannula over the groove after its insertion (`--fire-cannula`, docs/insertion.md#the-sample-firing-the-cannula). "
-      "I_s is the extent along the axis of the tissue it enclosed that touched the groove floor during the stroke. The runs' tissue: "
+      "I_s is the extent along the axis of the tissue it enclosed that touches the groove floor when it stops (the issue's "
+      "definition; summary.json also has the extent of the tissue that touched the floor at any time during the stroke). The runs' tissue: "
       "{}. The measured lengths are the paper's, in ex-vivo chicken breast (ten each, pooled SD about 1.6 mm): the comparison is of "
       "the PVC model with chicken breast, so the ratios to SB, not the millimetres, are what it can be judged on.\n\n",
       tissue.empty() ? "the scene's" : tissue);
   md += "| needle | I_s predicted (mm) | ratio to SB | I_s measured (mm) | measured ratio | floor contact before firing | whole sample length (mm) | "
-        "volume (mm³) |\n|---|---|---|---|---|---|---|---|\n";
+        "volume (mm³) | volume's ratio to SB |\n|---|---|---|---|---|---|---|---|---|\n";
   for (const SampledNeedle& n : needles) {
     const double ratio = sb && sb->I_s_mm > 0 ? n.I_s_mm / sb->I_s_mm : std::nan("");
     const double measured_ratio = sb && std::isfinite(sb->measured_I_s_mm) ? n.measured_I_s_mm / sb->measured_I_s_mm : std::nan("");
-    md += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} |\n", n.name, number(n.I_s_mm, "{:.2f}"), number(ratio, "{:.2f}"),
+    const double volume_ratio = sb && sb->volume_mm3 > 0 ? n.volume_mm3 / sb->volume_mm3 : std::nan("");
+    md += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", n.name, number(n.I_s_mm, "{:.2f}"), number(ratio, "{:.2f}"),
                       number(n.measured_I_s_mm, "{:.1f}"), number(measured_ratio, "{:.2f}"), number(n.floor_contact_before, "{:.3f}"),
-                      number(n.length_mm, "{:.2f}"), number(n.volume_mm3, "{:.3f}"));
+                      number(n.length_mm, "{:.2f}"), number(n.volume_mm3, "{:.3f}"), number(volume_ratio, "{:.2f}"));
   }
   std::vector<const SampledNeedle*> ranked;
   for (const SampledNeedle& n : needles)
@@ -61,7 +63,10 @@ std::string sampling_section(const std::vector<SampledNeedle>& needles, const st
   std::stable_sort(ranked.begin(), ranked.end(), [](const SampledNeedle* a, const SampledNeedle* b) { return a->I_s_mm > b->I_s_mm; });
   std::string order;
   for (const SampledNeedle* n : ranked) order += (order.empty() ? "" : " > ") + n->name;
-  md += fmt::format("\nRanked by predicted I_s (longest first): {}. Measured: LMB (12.9) > SB (12.5) > AMB (9.9) > HMB (8.6) mm.\n\n", order);
+  md += fmt::format("\nRanked by predicted I_s (longest first): {}. Measured: LMB (12.9) > SB (12.5) > AMB (9.9) > HMB (8.6) mm. Where "
+                    "the tissue touches the floor at both of the groove's ends, I_s is the groove's whole length and cannot tell the needles "
+                    "apart; the sample's volume can.\n\n",
+                    order);
   const SamplingVerdict v = judge_sampling(needles);
   md += fmt::format("| target | verdict |\n|---|---|\n| SB and LMB above AMB, AMB above HMB | {} |\n| each ratio to SB within {:.2f} of the "
                     "measured (1.00, 1.03, 0.79, 0.69) | {} (worst miss {:.2f}) |\n\n",

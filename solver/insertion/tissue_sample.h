@@ -9,7 +9,7 @@
 // spacing of its centre along x.
 //   length_mm:       the extent along the axis of all captured tissue (its front edge less its back edge);
 //   floor_length_mm: the extent of the captured tissue touching the groove floor (a contact with a groove_floor
-//                    triangle): the sample length I_s compared with the paper's;
+//                    triangle; the caller says when): the sample length I_s compared with the paper's;
 //   floor_covered_mm: the length of the axis under floor-touching tissue (gaps left out), at most floor_length_mm;
 //   volume_mm3, mass_g: the captured particles' reference volume and (physical) mass.
 #include <Eigen/Dense>

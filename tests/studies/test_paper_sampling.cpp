@@ -42,7 +42,7 @@ TEST_CASE("The sampling targets: the ranking and each ratio to SB within 0.15 of
 TEST_CASE("The sampling section tabulates each needle's sample and ratio, and is empty without a sample", "[studies][cannula]") {
   const std::string md = sampling_section(needles(12.5, 12.9, 9.9, 8.6), "PVC card, E 0.0855 MPa");
   CHECK(md.find("## The sample") != std::string::npos);
-  CHECK(md.find("| AMB | 9.90 | 0.79 | 9.9 | 0.79 |") != std::string::npos);
+  CHECK(md.find("| AMB | 9.90 | 0.79 | 9.9 | 0.79 | 0.100 | 9.90 | 1.000 | 1.00 |") != std::string::npos);
   CHECK(md.find("Ranked by predicted I_s (longest first): LMB > SB > AMB > HMB") != std::string::npos);
   CHECK(md.find("PVC card, E 0.0855 MPa") != std::string::npos);
   std::vector<SampledNeedle> none = needles(1, 1, 1, 1);
