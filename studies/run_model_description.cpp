@@ -36,6 +36,7 @@ std::string describe_run_model(const Scene& scene, long particles) {
                     "ends that much less deep)",
                     t.entry_x_mm));
   say(scene.motion.describe());
+  say(scene.cannula_firing.describe());
   // The presets' groove (its front wall 3 mm behind A) goes unnamed; another start is said.
   if (!std::isnan(scene.needle.groove_start_mm))
     say(fmt::format("the groove starts {:g} mm behind the tip point (the presets': {:g})", scene.needle.groove_start_mm,
