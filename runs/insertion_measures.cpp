@@ -71,6 +71,7 @@ TissueSample run_tissue_sample(CoupledInsertion& run, const SceneNeedle& needle,
     in.x_lo_mm = std::max(in.x_lo_mm, needle.groove->back_x_mm);
     in.x_hi_mm = std::min(in.x_hi_mm, needle.groove->front_x_mm);
     in.floor_y_mm = needle.groove->floor_y_mm;
+    in.contact_skin_mm = run.contact_model().options().skin_mm;
   }
   return measure_tissue_sample(in);
 }

@@ -283,6 +283,9 @@ class InsertionRunModel : public RunModel {
         {"floor_length_mm", sample.floor_length_mm},
         {"floor_covered_mm", sample.floor_covered_mm},
         {"floor_length_during_stroke_mm", touched_during_stroke.floor_length_mm},
+        {"floor_layer_length_mm", sample.floor_layer_length_mm},
+        {"floor_layer_covered_mm", sample.floor_layer_covered_mm},
+        {"floor_layer_particles", sample.floor_layer_particles},
         {"length_mm", sample.length_mm},
         {"volume_mm3", sample.volume_mm3},
         {"mass_g", sample.mass_g},
@@ -298,7 +301,8 @@ class InsertionRunModel : public RunModel {
         {"definition", "solver/insertion/tissue_sample.h: the particles inside the cannula's mid-wall radius, between the groove's walls within "
                        "the stroke, above the groove floor less half a spacing, when the cannula stops, in the needle's reference frame; I_s_mm is "
                        "the extent along the axis of those touching the groove floor then (floor_length_during_stroke_mm: of those that "
-                       "touched it at any record during the stroke); x in the needle's reference frame (tip point A at 0)"}};
+                       "touched it at any record during the stroke; floor_layer_*: of those whose centre lies within the contact's skin and a "
+                       "quarter spacing of the floor, by geometry); x in the needle's reference frame (tip point A at 0)"}};
   }
   std::string log_steps(double solve_s) const override {
     return fmt::format("{} coupling steps and {} needle steps in {:.2f} s, energy balance error {:.3g}, max penetration {:.3g} mm, {} particles "

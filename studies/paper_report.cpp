@@ -84,6 +84,7 @@ struct NeedleRun : NeedleOutcome {
   double runtime_s = kNaN, floor_contact_fraction = kNaN, mean_gap_mm = kNaN, max_energy_error = kNaN, max_penetration_mm = kNaN;
   double sample_I_s_mm = kNaN, sample_length_mm = kNaN, sample_volume_mm3 = kNaN, sample_floor_covered_mm = kNaN;  // a fired cannula's
   long sample_floor_particles = 0;
+  double sample_floor_layer_length_mm = kNaN, sample_floor_layer_covered_mm = kNaN;
   long bonds_broken = 0, bonds_cut_by_needle = 0, particles_inside = 0, steps = 0, particles = 0;
   std::string model_description;  // from the run's scene.json: the particles, the needle's cut, the law and the drive where not the paper's
   bool needle_cuts = false;       // the scene's tissue.contact.cuts_bonds
@@ -122,6 +123,8 @@ NeedleRun read_run(const std::string& out_dir, const std::string& name) {
     r.sample_volume_mm3 = number_or_nan(s["sample"], "volume_mm3");
     r.sample_floor_covered_mm = number_or_nan(s["sample"], "floor_covered_mm");
     r.sample_floor_particles = s["sample"].value("floor_particles", 0L);
+    r.sample_floor_layer_length_mm = number_or_nan(s["sample"], "floor_layer_length_mm");
+    r.sample_floor_layer_covered_mm = number_or_nan(s["sample"], "floor_layer_covered_mm");
   }
   r.particles = s.value("particles", 0L);
   const fs::path scene_path = fs::path(r.folder) / "scene.json";
@@ -495,7 +498,7 @@ void write_paper_report(const PaperReportInput& in) {
     for (const NeedleRun& r : runs) {
       const PaperReferenceNeedle* ref = find_reference(in.reference, r.name);
       sampled.push_back({r.name, r.sample_I_s_mm, r.sample_length_mm, r.sample_volume_mm3, r.sample_floor_covered_mm, r.sample_floor_particles,
-                         r.floor_contact_fraction, ref ? ref->sample_length_mm : kNaN});
+                         r.sample_floor_layer_length_mm, r.sample_floor_layer_covered_mm, r.floor_contact_fraction, ref ? ref->sample_length_mm : kNaN});
     }
     md += sampling_section(sampled, tissue);
   }

@@ -48,14 +48,16 @@ std::string sampling_section(const std::vector<SampledNeedle>& needles, const st
       "the PVC model with chicken breast, so the ratios to SB, not the millimetres, are what it can be judged on.\n\n",
       tissue.empty() ? "the scene's" : tissue);
   md += "| needle | I_s predicted (mm) | ratio to SB | I_s measured (mm) | measured ratio | particles on the floor | floor covered (mm) | "
-        "floor contact before firing | whole sample length (mm) | volume (mm³) | volume's ratio to SB |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+        "floor layer: extent / covered (mm) | floor contact before firing | whole sample length (mm) | volume (mm³) | volume's ratio to SB |\n"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const SampledNeedle& n : needles) {
     const double ratio = sb && sb->I_s_mm > 0 ? n.I_s_mm / sb->I_s_mm : std::nan("");
     const double measured_ratio = sb && std::isfinite(sb->measured_I_s_mm) ? n.measured_I_s_mm / sb->measured_I_s_mm : std::nan("");
     const double volume_ratio = sb && sb->volume_mm3 > 0 ? n.volume_mm3 / sb->volume_mm3 : std::nan("");
-    md += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", n.name, number(n.I_s_mm, "{:.2f}"), number(ratio, "{:.2f}"),
-                      number(n.measured_I_s_mm, "{:.1f}"), number(measured_ratio, "{:.2f}"), n.floor_particles,
-                      number(n.floor_covered_mm, "{:.2f}"), number(n.floor_contact_before, "{:.3f}"),
+    md += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} / {} | {} | {} | {} | {} |\n", n.name, number(n.I_s_mm, "{:.2f}"),
+                      number(ratio, "{:.2f}"), number(n.measured_I_s_mm, "{:.1f}"), number(measured_ratio, "{:.2f}"), n.floor_particles,
+                      number(n.floor_covered_mm, "{:.2f}"), number(n.floor_layer_length_mm, "{:.2f}"), number(n.floor_layer_covered_mm, "{:.2f}"),
+                      number(n.floor_contact_before, "{:.3f}"),
                       number(n.length_mm, "{:.2f}"), number(n.volume_mm3, "{:.3f}"), number(volume_ratio, "{:.2f}"));
   }
   std::vector<const SampledNeedle*> ranked;
@@ -67,7 +69,9 @@ std::string sampling_section(const std::vector<SampledNeedle>& needles, const st
   md += fmt::format("\nRanked by predicted I_s (longest first): {}. Measured: LMB (12.9) > SB (12.5) > AMB (9.9) > HMB (8.6) mm. I_s is the "
                     "extent between the outermost floor-touching particles: where a few of them lie near the groove's ends it reads "
                     "nearly the whole groove however little of the floor is covered (the floor-covered length and the particle count "
-                    "say how much rests on how few).\n\n",
+                    "say how much rests on how few). The kinematic contact lists a particle as touching only in a step it pushes it "
+                    "back; the floor layer counts, by geometry, every particle whose centre lies within the contact's skin and a "
+                    "quarter spacing of the floor.\n\n",
                     order);
   const SamplingVerdict v = judge_sampling(needles);
   md += fmt::format("| target | verdict |\n|---|---|\n| SB and LMB above AMB, AMB above HMB | {} |\n| each ratio to SB within {:.2f} of the "

@@ -13,6 +13,7 @@ struct SampledNeedle {
   double I_s_mm, length_mm, volume_mm3;  // the run's sample (NaN: its scene did not fire the cannula)
   double floor_covered_mm;               // the length of the axis under the sample's floor-touching tissue (gaps left out)
   long floor_particles;                  // how many particles touch the floor (I_s is the extent between the outermost)
+  double floor_layer_length_mm, floor_layer_covered_mm;  // the same two for the floor's nearest layer, by geometry
   double floor_contact_before;          // the groove's floor contact fraction at the insertion's end
   double measured_I_s_mm;               // the paper's (NaN: none)
 };

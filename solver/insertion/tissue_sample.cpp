@@ -17,8 +17,8 @@ TissueSample measure_tissue_sample(const TissueSampleInput& in) {
   NEEDLE_REQUIRE(in.bore_radius_mm > 0, "tissue sample: the bore's radius must be positive");
   TissueSample out;
   out.captured.assign(n, 0);
-  double back = std::numeric_limits<double>::infinity(), front = -back, floor_back = back, floor_front = -back;
-  std::vector<std::pair<double, double>> floor_spans;
+  double back = std::numeric_limits<double>::infinity(), front = -back;
+  std::vector<std::pair<double, double>> floor_spans, layer_spans;  // each floor particle's interval along x
   for (size_t i = 0; i < n; ++i) {
     const Eigen::Vector3d& X = in.reference_points[i];
     const double h = in.spacing_mm[i];
@@ -32,23 +32,22 @@ TissueSample measure_tissue_sample(const TissueSampleInput& in) {
     const double lo = std::max(in.x_lo_mm, X.x() - 0.5 * h), hi = std::min(in.x_hi_mm, X.x() + 0.5 * h);
     back = std::min(back, lo);
     front = std::max(front, hi);
-    if (!in.touches_floor.empty() && in.touches_floor[i]) {
-      ++out.floor_particles;
-      floor_back = std::min(floor_back, lo);
-      floor_front = std::max(floor_front, hi);
-      floor_spans.emplace_back(lo, hi);
-    }
+    if (!in.touches_floor.empty() && in.touches_floor[i]) floor_spans.emplace_back(lo, hi);
+    if (in.floor_y_mm && X.y() - *in.floor_y_mm <= in.contact_skin_mm + 0.25 * h) layer_spans.emplace_back(lo, hi);
   }
   if (out.particles > 0) {
     out.back_x_mm = back;
     out.front_x_mm = front;
     out.length_mm = front - back;
   }
-  if (out.floor_particles > 0) {
-    out.floor_length_mm = floor_front - floor_back;
-    std::sort(floor_spans.begin(), floor_spans.end());
-    double covered = 0, run_lo = floor_spans.front().first, run_hi = floor_spans.front().second;
-    for (const auto& [lo, hi] : floor_spans) {
+  // The extent of a set of intervals and the length they cover (gaps left out).
+  const auto extent_and_cover = [](std::vector<std::pair<double, double>> spans, double& extent, double& covered) {
+    extent = covered = 0;
+    if (spans.empty()) return;
+    std::sort(spans.begin(), spans.end());
+    double run_lo = spans.front().first, run_hi = spans.front().second, last = run_hi;
+    for (const auto& [lo, hi] : spans) {
+      last = std::max(last, hi);
       if (lo > run_hi) {
         covered += run_hi - run_lo;
         run_lo = lo;
@@ -57,8 +56,13 @@ TissueSample measure_tissue_sample(const TissueSampleInput& in) {
         run_hi = std::max(run_hi, hi);
       }
     }
-    out.floor_covered_mm = covered + (run_hi - run_lo);
-  }
+    covered += run_hi - run_lo;
+    extent = last - spans.front().first;
+  };
+  out.floor_particles = static_cast<std::int64_t>(floor_spans.size());
+  out.floor_layer_particles = static_cast<std::int64_t>(layer_spans.size());
+  extent_and_cover(std::move(floor_spans), out.floor_length_mm, out.floor_covered_mm);
+  extent_and_cover(std::move(layer_spans), out.floor_layer_length_mm, out.floor_layer_covered_mm);
   return out;
 }
 

@@ -11,6 +11,12 @@
 //   floor_length_mm: the extent of the captured tissue touching the groove floor (a contact with a groove_floor
 //                    triangle; the caller says when): the sample length I_s compared with the paper's;
 //   floor_covered_mm: the length of the axis under floor-touching tissue (gaps left out), at most floor_length_mm;
+//   floor_layer_length_mm, floor_layer_covered_mm: the same two for the captured particles of the floor's nearest layer,
+//                    by geometry: the centre within the contact's skin and a quarter of its spacing of the floor (the
+//                    contact holds a resting particle at the skin; the next layer lies a spacing higher). The kinematic
+//                    contact lists a particle
+//                    as touching only in a step it pushes it back, so a sample resting on the floor is counted by a
+//                    few of its particles at a time; the layer counts all of them;
 //   volume_mm3, mass_g: the captured particles' reference volume and (physical) mass.
 #include <Eigen/Dense>
 #include <cstdint>
@@ -26,11 +32,14 @@ struct TissueSampleInput {
   double bore_radius_mm = 0.61;                   // the cylinder the edge cut along
   double x_lo_mm = 0, x_hi_mm = 0;
   std::optional<double> floor_y_mm;               // the groove's floor (none: no groove)
+  double contact_skin_mm = 0.02;                  // the floor's nearest layer: centres within skin + h/4 of it
 };
 
 struct TissueSample {
   std::int64_t particles = 0, floor_particles = 0;
   double length_mm = 0, floor_length_mm = 0, floor_covered_mm = 0, volume_mm3 = 0, mass_g = 0;
+  double floor_layer_length_mm = 0, floor_layer_covered_mm = 0;
+  std::int64_t floor_layer_particles = 0;
   double back_x_mm = 0, front_x_mm = 0;  // the captured tissue's extent (reference frame; 0 when empty)
   std::vector<std::uint8_t> captured;    // per particle
 };

@@ -210,10 +210,11 @@ TEST_CASE("A cannula fired along a hole wider than it takes nothing", "[solver][
 }
 
 TEST_CASE("The sample's lengths: the extent of the captured tissue and of the tissue on the floor, gaps left out of the covered length", "[solver][cannula]") {
-  // Five particles of 0.2 mm on the axis line at x = 0, 0.2, 1.0, 1.2, 3.0 (mm), one beyond the bore, one below the
-  // floor; the floor touched by those at 0.2, 1.0 and 1.2.
+  // Five particles of 0.2 mm at x = 0, 0.2, 1.0, 1.2, 3.0 (mm), one beyond the bore, one below the floor; the floor
+  // (y = -0.07) touched by those at 0.2, 1.0 and 1.2 by the contact's list, and by geometry (centre within the skin
+  // 0.02 and a quarter spacing, 0.05, of it: y <= 0) the ones at 0 and 1.0, which sit at y = -0.05.
   TissueSampleInput in;
-  in.reference_points = {{0, 0.1, 0}, {0.2, 0.1, 0}, {1.0, 0.1, 0}, {1.2, 0.1, 0}, {3.0, 0.1, 0}, {2.0, 0.7, 0}, {2.0, -0.3, 0}};
+  in.reference_points = {{0, -0.05, 0}, {0.2, 0.1, 0}, {1.0, -0.05, 0}, {1.2, 0.1, 0}, {3.0, 0.1, 0}, {2.0, 0.7, 0}, {2.0, -0.3, 0}};
   in.spacing_mm.assign(7, 0.2);
   in.volume_mm3.assign(7, 0.008);
   in.mass_g.assign(7, 0.001);
@@ -231,6 +232,9 @@ TEST_CASE("The sample's lengths: the extent of the captured tissue and of the ti
   CHECK(s.volume_mm3 == Approx(5 * 0.008));
   CHECK(s.mass_g == Approx(5 * 0.001));
   CHECK(s.back_x_mm == Approx(-0.1));
+  CHECK(s.floor_layer_particles == 2);
+  CHECK(s.floor_layer_length_mm == Approx(1.1 - (-0.1)));
+  CHECK(s.floor_layer_covered_mm == Approx(0.2 + 0.2));
 }
 
 TEST_CASE("The needle's axis frame carries a point beside a translated and bent needle back to its place", "[solver][cannula]") {
