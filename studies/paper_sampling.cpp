@@ -71,7 +71,9 @@ std::string sampling_section(const std::vector<SampledNeedle>& needles, const st
                     "nearly the whole groove however little of the floor is covered (the floor-covered length and the particle count "
                     "say how much rests on how few). The kinematic contact lists a particle as touching only in a step it pushes it "
                     "back; the floor layer counts, by geometry, every particle whose centre lies within the contact's skin and a "
-                    "quarter spacing of the floor.\n\n",
+                    "quarter spacing of the floor. The floor layer was added after the first results on these four needles: a "
+                    "measure chosen after looking, not a prediction, and the targets below are judged on I_s "
+                    "(docs/notebook/sampling.md).\n\n",
                     order);
   const SamplingVerdict v = judge_sampling(needles);
   md += fmt::format("| target | verdict |\n|---|---|\n| SB and LMB above AMB, AMB above HMB | {} |\n| each ratio to SB within {:.2f} of the "
