@@ -87,14 +87,19 @@ void read_needle(SceneObject o, NeedleScene& n, const std::string& scene_folder)
   o.finish();
 }
 
+// A drive's speed: positive and at most InsertionProfile::kMaxSpeedMPerS (beyond it a typo); `typical` says what is usual.
+ValueCheck drive_speed(const std::string& typical) {
+  return [typical](double v) {
+    return v > 0 && v <= InsertionProfile::kMaxSpeedMPerS
+               ? std::string()
+               : fmt::format("must be positive and at most {:g} m/s ({})", InsertionProfile::kMaxSpeedMPerS, typical);
+  };
+}
+
 void read_motion(SceneObject o, Scene& s) {
   InsertionProfile& p = s.motion;
   p.accel_time_ms = o.quantity("accel_time", Dimension::time, p.accel_time_ms, non_negative());
-  p.speed_mm_per_ms = o.quantity("speed", Dimension::speed, p.speed_mm_per_ms, [](double v) {
-    return v > 0 && v <= InsertionProfile::kMaxSpeedMPerS
-               ? std::string()
-               : fmt::format("must be positive and at most {:g} m/s (the paper's drive: 8 m/s)", InsertionProfile::kMaxSpeedMPerS);
-  });
+  p.speed_mm_per_ms = o.quantity("speed", Dimension::speed, p.speed_mm_per_ms, drive_speed("the paper's drive: 8 m/s"));
   p.travel_mm = o.quantity("travel", Dimension::length, p.travel_mm, positive());
   p.decel_time_ms = o.quantity("decel_time", Dimension::time, p.decel_time_ms, non_negative());
   p.hold_ms = o.quantity("hold", Dimension::time, p.hold_ms, non_negative());
@@ -110,11 +115,7 @@ void read_motion(SceneObject o, Scene& s) {
 
 void read_cannula_firing(SceneObject o, CannulaFiringOptions& f) {
   f.enabled = o.boolean("enabled", f.enabled);
-  f.speed_mm_per_ms = o.quantity("speed", Dimension::speed, f.speed_mm_per_ms, [](double v) {
-    return v > 0 && v <= InsertionProfile::kMaxSpeedMPerS
-               ? std::string()
-               : fmt::format("must be positive and at most {:g} m/s (the paper's device: about 4 m/s)", InsertionProfile::kMaxSpeedMPerS);
-  });
+  f.speed_mm_per_ms = o.quantity("speed", Dimension::speed, f.speed_mm_per_ms, drive_speed("the paper's device: about 4 m/s"));
   f.throw_mm = o.quantity("throw", Dimension::length, f.throw_mm, positive());
   f.dwell_ms = o.quantity("dwell", Dimension::time, f.dwell_ms, non_negative());
   f.lead_in_mm = o.quantity("lead_in", Dimension::length, f.lead_in_mm, non_negative());

@@ -74,6 +74,19 @@ std::int64_t fire(CannulaFiring& firing, SpgTissue& tissue, TissueDynamics& dyna
   return cut;
 }
 
+// What the tube encloses at the end (no groove: every particle in its bore within its stroke).
+TissueSample sample_in_stroke(const CannulaFiring& firing, const TissueParticles& p) {
+  TissueSampleInput in;
+  in.reference_points = firing.reference_points(p.position_mm, Eigen::MatrixX3d(0, 3));
+  in.spacing_mm = p.spacing_mm;
+  in.volume_mm3 = p.reference_volume_mm3;
+  in.mass_g = p.mass_g;
+  in.bore_radius_mm = firing.tube().mid_radius_mm();
+  in.x_lo_mm = firing.stroke().start_x_mm;
+  in.x_hi_mm = firing.stroke().stop_x_mm;
+  return measure_tissue_sample(in);
+}
+
 }  // namespace
 
 TEST_CASE("The cannula's edge cuts exactly the bonds whose segment meets its mid-wall cylinder behind its front", "[solver][cannula]") {
@@ -122,15 +135,7 @@ TEST_CASE("A cannula fired through free tissue without a needle cuts out a cylin
       ++straddling;
   CHECK(straddling == 0);
 
-  TissueSampleInput in;
-  in.reference_points = firing.reference_points(p.position_mm, Eigen::MatrixX3d(0, 3));
-  in.spacing_mm = p.spacing_mm;
-  in.volume_mm3 = p.reference_volume_mm3;
-  in.mass_g = p.mass_g;
-  in.bore_radius_mm = firing.tube().mid_radius_mm();
-  in.x_lo_mm = firing.stroke().start_x_mm;
-  in.x_hi_mm = firing.stroke().stop_x_mm;
-  const TissueSample sample = measure_tissue_sample(in);
+  const TissueSample sample = sample_in_stroke(firing, p);
   std::int64_t started_inside = 0;
   for (size_t i = 0; i < start.size(); ++i) {
     const bool inside = radius(start[i]) < kMidRadiusMm;
@@ -195,15 +200,7 @@ TEST_CASE("A cannula fired along a hole wider than it takes nothing", "[solver][
   CHECK(fire(firing, tissue, dynamics, true) == 0);
   CHECK(firing.pushes() == 0);
   const TissueParticles& p = tissue.particles();
-  TissueSampleInput in;
-  in.reference_points = firing.reference_points(p.position_mm, Eigen::MatrixX3d(0, 3));
-  in.spacing_mm = p.spacing_mm;
-  in.volume_mm3 = p.reference_volume_mm3;
-  in.mass_g = p.mass_g;
-  in.bore_radius_mm = firing.tube().mid_radius_mm();
-  in.x_lo_mm = -0.5;
-  in.x_hi_mm = 3.5;
-  const TissueSample sample = measure_tissue_sample(in);
+  const TissueSample sample = sample_in_stroke(firing, p);
   CHECK(sample.particles == 0);
   CHECK(sample.volume_mm3 == 0);
   CHECK(sample.length_mm == 0);
