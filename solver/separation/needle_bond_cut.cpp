@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -26,6 +27,7 @@ struct NeedleBondCut::Grid {
   double cell_mm = 1;
   std::vector<int> start, entries;
   std::vector<std::uint8_t> near;  // per cell: 1 when the cell or one of its 26 neighbours holds a triangle
+  std::uint64_t mirrored_signature = 0;  // which triangles a half model mirrors (a hash of their indices)
 
   Eigen::Vector3i cell_of(const Eigen::Vector3d& p) const {
     Eigen::Vector3i c = ((p - lo) / cell_mm).array().floor().cast<int>();
@@ -43,6 +45,17 @@ constexpr double kBarycentricTolerance = 1e-9;  // a segment through a shared ed
 constexpr double kDistinctCrossing = 1e-7;      // crossings closer than this (in s) are the same point
 
 constexpr double kBoxSlackMm = 1e-6;            // a triangle's box is widened by this before the exact test
+
+// The certificates (see the header): the box they look within is widened along each axis by the needle's motion there
+// over kCertificateSteps steps, at least kMinDilationMm and at most kMaxDilationMm; no gap exceeds the latter, and the
+// grid holds the triangles within that of the particles' box, so a triangle left out lies apart by more. Gaps are
+// taken kCertificateSafetyMm short (rounding at the cells' faces); the tissue's own motion, which the needle's does
+// not bound, counts as kParticleRateMm a step when the longest-lasting gaps are chosen.
+constexpr double kCertificateSteps = 8;
+constexpr double kMinDilationMm = 0.01;
+constexpr double kMaxDilationMm = 0.1;
+constexpr double kCertificateSafetyMm = 1e-9;
+constexpr double kParticleRateMm = 1e-4;
 
 // Parameter s in [0, 1] where a + s (b - a) meets triangle t (Moeller-Trumbore), or NaN; length = |b - a|.
 template <class Triangle>
@@ -67,7 +80,8 @@ double segment_triangle(const Eigen::Vector3d& a, const Eigen::Vector3d& d, doub
 
 }  // namespace
 
-NeedleBondCut::NeedleBondCut(const ContactSurface& surface, double candidate_margin_mm) : surface_(surface), margin_mm_(candidate_margin_mm) {}
+NeedleBondCut::NeedleBondCut(const ContactSurface& surface, double candidate_margin_mm, bool certify)
+    : surface_(surface), margin_mm_(candidate_margin_mm), certify_(certify && candidate_margin_mm > 0) {}
 
 NeedleBondCut::Grid NeedleBondCut::build_grid(const Eigen::MatrixX3d& needle_x, const Eigen::Vector3d& clip_lo, const Eigen::Vector3d& clip_hi) const {
   Grid grid;
@@ -101,6 +115,7 @@ NeedleBondCut::Grid NeedleBondCut::build_grid(const Eigen::MatrixX3d& needle_x, 
     // The mirror image closes a half model's surface; only triangles on the plane can meet a segment
     // that stays on the model's side (z >= 0).
     if (surface_.half_model() && tlo.z() <= plane_tol) {
+      grid.mirrored_signature = grid.mirrored_signature * 1000003u + static_cast<std::uint64_t>(t) + 1;
       std::array<Eigen::Vector3d, 3> m = v;
       for (auto& p : m) p.z() = -p.z();
       add(m);
@@ -155,7 +170,7 @@ NeedleBondCut::Grid NeedleBondCut::build_grid(const Eigen::MatrixX3d& needle_x, 
 }
 
 template <class Visit>
-void NeedleBondCut::for_each_hit(const Grid& grid, const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Visit& visit) const {
+void NeedleBondCut::for_each_hit(const Grid& grid, const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Visit& visit, bool* overlapped) const {
   const Eigen::Vector3d lo = a.cwiseMin(b), hi = a.cwiseMax(b);
   if ((hi.array() < grid.lo.array()).any() || (lo.array() > grid.hi.array()).any()) return;
   const Eigen::Vector3i c0 = grid.cell_of(lo), c1 = grid.cell_of(hi);
@@ -172,6 +187,7 @@ void NeedleBondCut::for_each_hit(const Grid& grid, const Eigen::Vector3d& a, con
         for (int e = grid.start[static_cast<size_t>(cell)]; e < grid.start[static_cast<size_t>(cell + 1)]; ++e) {
           const Grid::Triangle& t = grid.triangles[static_cast<size_t>(grid.entries[static_cast<size_t>(e)])];
           if ((hi.array() < t.lo.array()).any() || (lo.array() > t.hi.array()).any()) continue;  // boxes apart: no hit
+          if (overlapped) *overlapped = true;
           const double hit = segment_triangle(a, d, length, t);
           if (!std::isnan(hit) && !visit(hit)) return;
         }
@@ -201,6 +217,95 @@ bool NeedleBondCut::passes_through(const Grid& grid, const Eigen::Vector3d& a, c
     return !two;
   });
   return two;
+}
+
+bool NeedleBondCut::passes_through(const Grid& grid, const Eigen::Vector3d& a, const Eigen::Vector3d& b, bool& overlapped) const {
+  double lowest = std::numeric_limits<double>::infinity(), highest = -lowest;
+  bool two = false;
+  overlapped = false;
+  for_each_hit(grid, a, b, [&](double hit) {
+    lowest = std::min(lowest, hit);
+    highest = std::max(highest, hit);
+    two = highest - lowest >= kDistinctCrossing;
+    return !two;
+  }, &overlapped);
+  return two;
+}
+
+bool NeedleBondCut::passes_through_or_certify(const Grid& grid, const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& dilation,
+                                              const Eigen::Vector3d& rate, Eigen::Vector3d& gap) const {
+  const Eigen::Vector3d lo = a.cwiseMin(b), hi = a.cwiseMax(b);
+  const auto finish = [&gap](bool certified) {
+    if (certified) gap.array() -= kCertificateSafetyMm;
+    else gap.setZero();
+    return false;
+  };
+  // Wholly beside the grid's box along an axis: every triangle's box lies at least that far apart along it.
+  gap.setConstant(kMaxDilationMm);
+  bool outside = false;
+  for (int k = 0; k < 3; ++k) {
+    const double apart = std::max(grid.lo[k] - hi[k], lo[k] - grid.hi[k]);
+    if (apart > 0) {
+      gap[k] = std::min(gap[k], apart);
+      outside = true;
+    }
+  }
+  if (outside) return finish(true);
+  const Eigen::Vector3i c0 = grid.cell_of(lo), c1 = grid.cell_of(hi);
+  if ((c1 - c0).maxCoeff() <= 1 && !grid.near[static_cast<size_t>(grid.index(c0.x(), c0.y(), c0.z()))]) {
+    // No triangle in the 27 cells around c0, which hold the segment: every triangle's box lies beyond a face of that
+    // block, so apart along that face's axis by at least the segment's distance to it (a side the grid ends on has none).
+    for (int k = 0; k < 3; ++k) {
+      double apart = kMaxDilationMm;
+      if (c0[k] > 0) apart = std::min(apart, lo[k] - (grid.lo[k] + (c0[k] - 1) * grid.cell_mm));
+      if (c0[k] + 1 < grid.cells[k] - 1) apart = std::min(apart, grid.lo[k] + (c0[k] + 2) * grid.cell_mm - hi[k]);
+      gap[k] = apart;
+    }
+    return finish(true);
+  }
+  // The triangles whose boxes overlap the segment's are tested as passes_through tests them; the others lie apart
+  // along some axis, and each lowers the gap along one axis to its own separation there unless it is already
+  // covered: the axis whose lowered gaps last the most steps at the rates given.
+  gap = dilation.cwiseMin(Eigen::Vector3d::Constant(kMaxDilationMm));
+  const Eigen::Vector3d speed = rate.cwiseMax(Eigen::Vector3d::Constant(kParticleRateMm));
+  const Eigen::Vector3i d0 = grid.cell_of(lo - gap), d1 = grid.cell_of(hi + gap);
+  const Eigen::Vector3d d = b - a;
+  const double length = d.norm();
+  double lowest = std::numeric_limits<double>::infinity(), highest = -lowest;
+  bool certified = true;
+  for (int i = d0.x(); i <= d1.x(); ++i)
+    for (int j = d0.y(); j <= d1.y(); ++j)
+      for (int k = d0.z(); k <= d1.z(); ++k) {
+        const int cell = grid.index(i, j, k);
+        for (int e = grid.start[static_cast<size_t>(cell)]; e < grid.start[static_cast<size_t>(cell + 1)]; ++e) {
+          const Grid::Triangle& t = grid.triangles[static_cast<size_t>(grid.entries[static_cast<size_t>(e)])];
+          const Eigen::Vector3d apart = (t.lo - hi).cwiseMax(lo - t.hi);
+          if ((apart.array() > 0).any()) {  // boxes apart: no hit
+            if (!certified || (apart.array() >= gap.array()).any()) continue;
+            int best = -1;
+            double best_steps = -1;
+            for (int axis = 0; axis < 3; ++axis) {
+              if (!(apart[axis] > 0)) continue;
+              Eigen::Vector3d lowered = gap;
+              lowered[axis] = apart[axis];
+              const double steps = lowered.cwiseQuotient(speed).minCoeff();
+              if (steps > best_steps) {
+                best_steps = steps;
+                best = axis;
+              }
+            }
+            gap[best] = apart[best];
+            continue;
+          }
+          certified = false;
+          const double hit = segment_triangle(a, d, length, t);
+          if (std::isnan(hit)) continue;
+          lowest = std::min(lowest, hit);
+          highest = std::max(highest, hit);
+          if (highest - lowest >= kDistinctCrossing) return true;
+        }
+      }
+  return finish(certified);
 }
 
 std::vector<double> NeedleBondCut::surface_crossings(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
@@ -248,6 +353,84 @@ std::vector<std::int64_t> NeedleBondCut::scan(const Grid& grid, const IntactPair
   });
 }
 
+std::vector<std::int64_t> NeedleBondCut::scan_certified(const Grid& grid, const BondNetwork& bonds, const std::vector<Vec3d>& x) {
+  const std::vector<std::uint8_t> side = box_sides(x, grid.lo, grid.hi);
+  const std::int32_t now_index = static_cast<std::int32_t>(needle_motion_.size() - 1);
+  const Eigen::Vector3d now = needle_motion_.back();
+  const Eigen::Vector3d rate = needle_motion_.size() > 1 ? Eigen::Vector3d(now - needle_motion_[needle_motion_.size() - 2]) : Eigen::Vector3d::Zero();
+  const Eigen::Vector3d dilation = (kCertificateSteps * rate).cwiseMax(Eigen::Vector3d::Constant(kMinDilationMm));
+  std::atomic<std::int64_t> made{0}, skipped{0};
+  std::vector<std::int64_t> found_all = parallel_collect_chunks<std::int64_t>(
+      static_cast<std::int64_t>(candidates_.size()), [&](std::int64_t begin, std::int64_t end, std::vector<std::int64_t>& found) {
+        const Bond* const all = bonds.bonds.data();
+        const std::uint8_t* const sides = side.data();
+        const Vec3d* const positions = x.data();
+        const IntactPair* const pairs = candidates_.data();
+        Certificate* const certificates = certificates_.data();
+        std::int64_t chunk_made = 0, chunk_skipped = 0;
+        for (std::int64_t k = begin; k < end; ++k) {
+          const IntactPair pair = pairs[k];
+          if (sides[pair.i] & sides[pair.j]) continue;
+          if (all[pair.bond].broken) continue;
+          const Vec3d& a = positions[pair.i];
+          const Vec3d& b = positions[pair.j];
+          Certificate& c = certificates[k];
+          if (c.gap[0] > 0 && c.gap[1] > 0 && c.gap[2] > 0) {
+            const Eigen::Vector3d& then = needle_motion_[static_cast<size_t>(c.motion_index)];
+            bool holds = true;
+            for (int axis = 0; axis < 3 && holds; ++axis) {
+              const double moved = std::max(std::abs(a[axis] - c.a[axis]), std::abs(b[axis] - c.b[axis])) + (now[axis] - then[axis]);
+              holds = moved < c.gap[axis];
+            }
+            if (holds) {
+              ++chunk_skipped;
+              continue;
+            }
+          }
+          ++chunk_made;
+          // A bond whose box overlapped a triangle's at its last test most likely does again: the plain walk first.
+          if (c.gap[0] < 0) {
+            bool overlapped = false;
+            if (passes_through(grid, a, b, overlapped)) {
+              found.push_back(pair.bond);
+              continue;
+            }
+            if (overlapped) continue;
+          }
+          Eigen::Vector3d gap;
+          if (passes_through_or_certify(grid, a, b, dilation, rate, gap)) {
+            found.push_back(pair.bond);
+            continue;
+          }
+          if (!(gap.array() > 0).all()) {  // no certificate: a box overlapped (or a gap closed to nothing)
+            c.gap[0] = c.gap[1] = c.gap[2] = -1;
+            continue;
+          }
+          for (int axis = 0; axis < 3; ++axis) {
+            c.a[axis] = a[axis];
+            c.b[axis] = b[axis];
+            c.gap[axis] = gap[axis];
+          }
+          c.motion_index = now_index;
+        }
+        made += chunk_made;
+        skipped += chunk_skipped;
+      });
+  tests_made_ += made;
+  tests_skipped_ += skipped;
+  return found_all;
+}
+
+void NeedleBondCut::track_needle_motion(const Eigen::MatrixX3d& needle_x, std::uint64_t mirrored_signature) {
+  const bool same_needle = last_needle_x_.rows() == needle_x.rows() && !needle_motion_.empty();
+  if (same_needle) needle_motion_.push_back(needle_motion_.back() + (needle_x - last_needle_x_).cwiseAbs().colwise().maxCoeff().transpose());
+  else needle_motion_.assign(1, Eigen::Vector3d::Zero());
+  last_needle_x_ = needle_x;
+  if (!same_needle || mirrored_signature != mirrored_signature_)
+    for (Certificate& c : certificates_) c.gap[0] = c.gap[1] = c.gap[2] = 0;  // none, and no overlap known
+  mirrored_signature_ = mirrored_signature;
+}
+
 std::vector<std::int64_t> NeedleBondCut::bonds_through_needle(const BondNetwork& bonds, const std::vector<Vec3d>& x,
                                                               const Eigen::MatrixX3d& needle_x) const {
   const Grid grid = build_grid(needle_x, everywhere_lo(), everywhere_hi());
@@ -268,7 +451,10 @@ std::vector<std::int64_t> NeedleBondCut::bonds_through_needle_tracked(const Bond
     particles_hi = particles_hi.cwiseMax(x[i]);
     if (still) still = (x[i] - listed_x_[i]).cwiseAbs().maxCoeff() < half;
   }
-  const Grid grid = build_grid(needle_x, particles_lo, particles_hi);
+  // With certificates the grid also holds the triangles within reach of a gap (see kMaxDilationMm).
+  const double reach = certify_ ? kMaxDilationMm : 0.0;
+  const Grid grid = build_grid(needle_x, particles_lo.array() - reach, particles_hi.array() + reach);
+  if (certify_) track_needle_motion(needle_x, grid.mirrored_signature);
   if (!(margin_mm_ > 0)) return scan(grid, bonds.intact.data(), static_cast<std::int64_t>(bonds.intact.size()), bonds, x);
   // The list holds every bond the step could cut while the box lies within the listed box widened by half the margin
   // and no particle has moved half the margin along an axis: a bond left off had both ends beyond the listed box
@@ -290,7 +476,12 @@ std::vector<std::int64_t> NeedleBondCut::bonds_through_needle_tracked(const Bond
     listed_x_ = x;
     listed_ = true;
     ++lists_made_;
+    if (certify_) {  // every certificate starts anew, so the motion's bound need only keep its last two calls (the rate)
+      certificates_.assign(candidates_.size(), Certificate{});
+      needle_motion_.erase(needle_motion_.begin(), needle_motion_.end() - std::min<std::ptrdiff_t>(2, static_cast<std::ptrdiff_t>(needle_motion_.size())));
+    }
   }
+  if (certify_) return scan_certified(grid, bonds, x);
   return scan(grid, candidates_.data(), static_cast<std::int64_t>(candidates_.size()), bonds, x);
 }
 
@@ -304,6 +495,7 @@ void NeedleBondCut::add_summary(nlohmann::json& summary, const SpgTissue&) const
   summary["bonds_cut_by_needle"] = cut_;
   summary["bond_cut_s"] = wall_s_;
   summary["bond_cut_candidate_lists"] = lists_made_;
+  summary["bond_cut_tests"] = {{"made", tests_made_}, {"skipped_on_certificate", tests_skipped_}};
 }
 
 }  // namespace needle

@@ -124,13 +124,10 @@ TEST_CASE("The bonds through the rod are those whose segment dips into the cylin
   CHECK(mismatched == 0);
 }
 
-TEST_CASE("The candidate list cuts the same bonds, in the same order, as a scan of every intact bond", "[solver][bond_cut][gmsh][slow]") {
-  // The rod pushed 2 mm into a block ahead of its tip, 0.04 mm a step, while the particles wander (up to 0.006 mm a
-  // step along each axis, a seeded sequence): each step the tracked search and the full scan must find the same list;
-  // the bonds found are then broken, as a run breaks them.
-  const TetMesh mesh = rod_mesh(true);
-  const ContactSurface surface(mesh);
-  NeedleBondCut tracked(surface), full(surface, 0.0);
+namespace {
+
+// A particle block ahead of the rod's tip (0.2 mm lattice, supports of 0.8 mm), the particles off the rod's axis plane.
+SpgTissue block_ahead_of_rod() {
   TissueBox box;
   box.min_mm = {0.1, -1.2, 0.0};
   box.max_mm = {2.5, 1.2, 1.2};
@@ -142,35 +139,97 @@ TEST_CASE("The candidate list cuts the same bonds, in the same order, as a scan 
   for (Eigen::Index i = 0; i < particles.x_mm.rows(); ++i) particles.x_mm(i, 1) += 0.021;  // none on the rod's axis plane
   SpgOptions spg;
   spg.dilation = 4.0;
-  const SpgTissue tissue(particles, TissueMaterial{}, spg);
+  return SpgTissue(particles, TissueMaterial{}, spg);
+}
+
+// Steps the rod (needle_at(step): its nodes' positions) through the block while the particles wander by up to
+// wander_mm along each axis a step (a seeded sequence, and a jump of jump_mm at jump_step). Each step the certified
+// search, the tracked search without certificates and the full scan must find the same list; the bonds found are
+// then broken, as a run breaks them. Returns the bonds cut.
+template <class NeedleAt>
+std::int64_t cut_alongside(NeedleBondCut& certified, int steps, const NeedleAt& needle_at, double wander_mm, int jump_step = -1,
+                           double jump_mm = 0) {
+  const TetMesh mesh = rod_mesh(true);
+  const ContactSurface& surface = certified.surface();
+  NeedleBondCut uncertified(surface, NeedleBondCut::kCandidateMarginMm, false), full(surface, 0.0);
+  const SpgTissue tissue = block_ahead_of_rod();
   BondNetwork bonds = tissue.bonds();
   std::vector<Vec3d> x = tissue.particles().position_mm;
   std::uint64_t state = 12345;
-  const auto wander = [&state] {  // in [-0.006, 0.006] mm
+  const auto wander = [&state](double amplitude) {  // in [-amplitude, amplitude]
     state = state * 6364136223846793005ull + 1442695040888963407ull;
-    return (static_cast<double>(state >> 11) / 9007199254740992.0 - 0.5) * 0.012;
+    return (static_cast<double>(state >> 11) / 9007199254740992.0 - 0.5) * 2 * amplitude;
   };
   std::int64_t cut = 0;
-  const int steps = 50;
   for (int step = 1; step <= steps; ++step) {
-    Eigen::MatrixX3d needle_x = mesh.X;
-    needle_x.col(0).array() += 0.04 * step;
+    const Eigen::MatrixX3d needle_x = needle_at(step);
     for (Vec3d& p : x)
-      for (int k = 0; k < 3; ++k) p[k] += wander();
-    const std::vector<std::int64_t> a = tracked.bonds_through_needle_tracked(bonds, x, needle_x);
-    const std::vector<std::int64_t> b = full.bonds_through_needle_tracked(bonds, x, needle_x);
+      for (int k = 0; k < 3; ++k) p[k] += wander(step == jump_step ? jump_mm : wander_mm);
+    const std::vector<std::int64_t> a = certified.bonds_through_needle_tracked(bonds, x, needle_x);
+    const std::vector<std::int64_t> b = uncertified.bonds_through_needle_tracked(bonds, x, needle_x);
+    const std::vector<std::int64_t> c = full.bonds_through_needle_tracked(bonds, x, needle_x);
     INFO("step " << step);
-    REQUIRE(a == b);
-    CHECK(b == full.bonds_through_needle(bonds, x, needle_x));
+    REQUIRE(a == c);
+    REQUIRE(b == c);
+    CHECK(c == full.bonds_through_needle(bonds, x, needle_x));
     for (std::int64_t bond : a) bonds.mark_broken(bond);
     cut += static_cast<std::int64_t>(a.size());
   }
+  return cut;
+}
+
+}  // namespace
+
+TEST_CASE("The candidate list cuts the same bonds, in the same order, as a scan of every intact bond", "[solver][bond_cut][gmsh][slow]") {
+  // The rod pushed 2 mm into the block, 0.04 mm a step, while the particles wander up to 0.006 mm a step.
+  const TetMesh mesh = rod_mesh(true);
+  const ContactSurface surface(mesh);
+  NeedleBondCut tracked(surface);
+  const int steps = 50;
+  const std::int64_t cut = cut_alongside(
+      tracked, steps,
+      [&mesh](int step) {
+        Eigen::MatrixX3d needle_x = mesh.X;
+        needle_x.col(0).array() += 0.04 * step;
+        return needle_x;
+      },
+      0.006);
   INFO(cut << " bonds cut; candidate lists made " << tracked.candidate_lists_made() << " times, the last of " << tracked.candidates()
-            << " pairs of " << bonds.intact.size());
+            << " pairs");
   CHECK(cut > 100);
-  // The list is made again only now and then (the tip's advance of 0.2 mm crosses half the margin every 5 steps), and
-  // holds fewer pairs than the block's intact bonds.
+  // The list is made again only now and then (the tip's advance of 0.2 mm crosses half the margin every 5 steps).
   CHECK(tracked.candidate_lists_made() >= 2);
   CHECK(tracked.candidate_lists_made() <= steps / 3);
-  CHECK(tracked.candidates() < bonds.intact.size());
+  CHECK(tracked.candidates() < block_ahead_of_rod().bonds().intact.size());
+}
+
+TEST_CASE("A bond's certificate skips its test only while nothing can have reached it", "[solver][bond_cut][gmsh][slow]") {
+  // The rod starts 1 mm into the block and creeps on (0.005 mm a step along its axis, bending up by up to 0.02 mm at its
+  // tip), the particles barely move (0.0005 mm a step): most tests are skipped on their certificates. Then, once, the
+  // rod jumps 0.12 mm sideways, and later the particles jump by up to 0.08 mm: the bonds it then cuts had certificates,
+  // which must not hold across the jump (a search that ignored the needle's or the particles' motion would miss them).
+  const TetMesh mesh = rod_mesh(true);
+  const ContactSurface surface(mesh);
+  const int steps = 60, sideways_step = 25, particles_jump_step = 45;
+  const auto needle_at = [&mesh](int step) {
+    Eigen::MatrixX3d needle_x = mesh.X;
+    const double tip_x = 1.0 + 0.005 * step;
+    needle_x.col(0).array() += tip_x;
+    for (Eigen::Index n = 0; n < needle_x.rows(); ++n) {
+      const double from_base = (mesh.X(n, 0) + kLength) / kLength;  // 0 at the base, 1 at the tip
+      needle_x(n, 1) += 0.02 * step / steps * from_base * from_base + (step >= sideways_step ? 0.12 : 0.0);
+    }
+    return needle_x;
+  };
+  NeedleBondCut certified(surface);
+  std::int64_t cut_before_jump = 0;
+  {
+    NeedleBondCut probe(surface);
+    cut_before_jump = cut_alongside(probe, sideways_step - 1, needle_at, 0.0005);
+  }
+  const std::int64_t cut = cut_alongside(certified, steps, needle_at, 0.0005, particles_jump_step, 0.08);
+  INFO(cut << " bonds cut (" << cut_before_jump << " before the sideways jump); tests made " << certified.tests_made() << ", skipped "
+            << certified.tests_skipped());
+  CHECK(cut > cut_before_jump + 50);                           // the jump cuts bonds that were certified a step before
+  CHECK(certified.tests_skipped() > certified.tests_made());  // the certificates do their work
 }
