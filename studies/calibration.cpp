@@ -89,6 +89,9 @@ CalibrationResult calibrate_tissue_E(const CalibrationRequest& o) {
   NEEDLE_REQUIRE(std::isfinite(o.sensitivity_step) && o.sensitivity_step >= 0 && o.sensitivity_step <= 1,
                  "--sensitivity-step must lie in [0, 1] (a relative change of E; 0: no sensitivity run)");
   const Scene& scene = o.scene;
+  NEEDLE_REQUIRE(!scene.cannula_firing.enabled,
+                 "needle calibrate reads the deflection at the end of the insertion; firing the cannula after it changes nothing it "
+                 "reads and nearly doubles each run: drop --fire-cannula (scene key cannula.firing.enabled)");
   const double start = std::isnan(o.start_E_MPa) ? scene.tissue.material.E_MPa : o.start_E_MPa;
   NEEDLE_REQUIRE(std::isfinite(start) && start > 0, "--start-E-MPa must be positive");
   const fs::path dir = named_folder(o.out_dir);

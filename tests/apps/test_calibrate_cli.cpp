@@ -78,3 +78,13 @@ TEST_CASE("needle calibrate takes the slope from a run of the same scene already
   REQUIRE(c["runs"].size() == 2);  // the run of the other scene is not listed
   CHECK(c["runs"][1]["run_folder"] == "runs/E_0.0748MPa");
 }
+
+TEST_CASE("needle calibrate refuses to fire the cannula, which changes nothing it reads, before it writes anything", "[apps][calibrate]") {
+  const fs::path dir = fs::temp_directory_path() / "needle_calibrate_fired";
+  fs::remove_all(dir);
+  const auto result = run(fmt::format("calibrate --preset SB --target-deflection-mm -1.14 --travel-mm 4 --fire-cannula --out {}", dir.string()), true);
+  INFO(result.out);
+  CHECK(result.exit_code == 2);
+  CHECK(result.out.find("drop --fire-cannula") != std::string::npos);
+  CHECK(!fs::exists(dir));
+}
