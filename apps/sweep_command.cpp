@@ -97,7 +97,7 @@ void run(const SweepOptions& o) {
     const int threads = o.threads > 0 ? o.threads : hardware_threads();
     const CaseResult r = run_design_case(plan.base, c.index, c.name, c.values, dir, threads, o.quiet, c.label);
     fmt::print("sweep: {} {} ({}){}\n", r.name, r.status, describe_values(r.values),
-               r.status == "finished" ? fmt::format(": deflection {:+.4f} mm, groove fill {:.3f}", r.deflection_mm, r.groove_fill) : ": " + r.reason);
+               ": " + (r.status == "finished" ? finished_case_words(r) : r.reason));
     return;
   }
   if (launched_by_mpi()) {

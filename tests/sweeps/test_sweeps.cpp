@@ -535,6 +535,11 @@ TEST_CASE("A sweep with the cannula fired tabulates and plots the sample's lengt
     CHECK(table.rows[k][table.index("sample_I_s_mm")] == summary["sample"]["I_s_mm"].get<double>());
   }
   CHECK(fs::exists(dir / "sweep" / "sample_length_vs_d_a_mm.png"));
+  // One case alone, as a worker, a batch array's task or an MPI rank runs it: its line says I_s too.
+  const Result task = run("sweep " + (dir / "sweep.json").string() + " --out " + (dir / "task").string() + " --task-index 1", true);
+  INFO(task.out);
+  REQUIRE(task.exit_code == 0);
+  CHECK(task.out.find("I_s") != std::string::npos);
 
   write(dir / "search.json", R"({"base": {"scene": "scene.json"}, "model": "fast",)"
                              R"("variables": {"d_a_mm": {"min": -0.3, "max": 0.3, "start": 0.0, "step": 0.2, "tolerance": 0.02}},)"
