@@ -31,6 +31,9 @@
 // bonds are cut, in the same order, as without the certificates (the test drives the needle and the particles both
 // ways, and a needle that jumps). The needle moves mostly along its axis and the tissue beside it barely at all, so
 // the gaps are found on a box widened along each axis by what the needle has been moving there, over a few steps.
+// The bonds lying along the needle's side overlap its facets' boxes; one wholly on one side of such a facet's plane is
+// apart from it while the motion along the facet's normal stays below its distance to the plane, and the gaps are
+// lowered until their motion along that normal does.
 #include <Eigen/Dense>
 #include <cstdint>
 #include <vector>
@@ -90,9 +93,10 @@ class NeedleBondCut : public SeparationModel {
   bool passes_through(const Grid& grid, const Eigen::Vector3d& a, const Eigen::Vector3d& b) const;
   bool passes_through(const Grid& grid, const Eigen::Vector3d& a, const Eigen::Vector3d& b, bool& overlapped) const;
 
-  // As passes_through, and when the segment does not pass through, the gaps of its certificate (all zero when a
-  // triangle's box overlaps the segment's). Looks at the triangles within dilation of the segment's box along each
-  // axis, and prefers the gaps that last the most steps at the needle's rate of motion along each axis.
+  // As passes_through, and when the segment does not pass through, the gaps of its certificate (all zero when none:
+  // a triangle's box overlaps the segment's and the segment crosses or touches its plane). Looks at the triangles within
+  // dilation of the segment's box along each axis, and prefers the gaps that last the most steps at the needle's rate
+  // of motion along each axis.
   bool passes_through_or_certify(const Grid& grid, const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& dilation,
                                  const Eigen::Vector3d& rate, Eigen::Vector3d& gap) const;
 

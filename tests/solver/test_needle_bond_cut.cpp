@@ -233,3 +233,27 @@ TEST_CASE("A bond's certificate skips its test only while nothing can have reach
   CHECK(cut > cut_before_jump + 50);                           // the jump cuts bonds that were certified a step before
   CHECK(certified.tests_skipped() > certified.tests_made());  // the certificates do their work
 }
+
+TEST_CASE("A bond certified by a triangle's plane is tested again before the needle can have crossed that plane",
+          "[solver][bond_cut][gmsh][slow]") {
+  // The rod rests 1 mm into the block and drifts sideways into it, 0.004 mm a step (less than the smallest box the
+  // certificates look within, 0.01 mm), the particles nearly still: the bonds lying along its side are certified by
+  // its facets' planes, each for as long as the drift cannot have closed its distance, and are cut as the rod reaches
+  // them. A certificate that ignored the motion along the facet's normal would skip them.
+  const TetMesh mesh = rod_mesh(true);
+  const ContactSurface surface(mesh);
+  const int steps = 40;
+  NeedleBondCut certified(surface);
+  const std::int64_t cut = cut_alongside(
+      certified, steps,
+      [&mesh](int step) {
+        Eigen::MatrixX3d needle_x = mesh.X;
+        needle_x.col(0).array() += 1.0 + 0.0005 * step;
+        needle_x.col(1).array() += 0.004 * step;
+        return needle_x;
+      },
+      0.0002);
+  INFO(cut << " bonds cut; tests made " << certified.tests_made() << ", skipped " << certified.tests_skipped());
+  CHECK(cut > 100);
+  CHECK(certified.tests_skipped() > certified.tests_made());
+}
