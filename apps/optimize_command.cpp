@@ -31,8 +31,7 @@ void run(const OptimizeOptions& o) {
     return;
   }
   const CaseResult& best = outcome.evaluations[static_cast<size_t>(outcome.best)];
-  fmt::print("optimize: best {} ({}): deflection {:+.4f} mm, groove fill {:.3f}\n", best.name, describe_values(best.values), best.deflection_mm,
-             best.groove_fill);
+  fmt::print("optimize: best {} ({}): {}\n", best.name, describe_values(best.values), finished_case_words(best));
   const fs::path recipe = fs::path(o.out_dir) / "best_recipe.json";
   fmt::print("optimize: evaluations {}, optimum {}{}\n", (fs::path(o.out_dir) / "evaluations.csv").string(), (fs::path(o.out_dir) / "optimum.json").string(),
              fs::exists(recipe) ? ", best tip " + recipe.string() + " (needle tip --recipe)" : "");

@@ -552,6 +552,10 @@ TEST_CASE("A sweep with the cannula fired tabulates and plots the sample's lengt
   REQUIRE(optimum.contains("best"));
   const double best_I_s = optimum["best"]["sample_I_s_mm"].get<double>();
   CHECK(optimum["best"]["meets_sample_length"] == (best_I_s >= 0.4));
+  const size_t best_line = search.out.find("optimize: best");  // the best's line says its sample length too
+  REQUIRE(best_line != std::string::npos);
+  const std::string best_words = search.out.substr(best_line, search.out.find('\n', best_line) - best_line);
+  CHECK(best_words.find(fmt::format("I_s {:.2f} mm", best_I_s)) != std::string::npos);
   const needle::CsvTable evaluations = needle::read_csv_table((dir / "search" / "evaluations.csv").string());
   CHECK_NOTHROW(evaluations.index("sample_I_s_mm"));
   const Result tip = run("tip --recipe " + (dir / "search" / "best_recipe.json").string() + " --json");
