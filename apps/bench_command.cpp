@@ -22,7 +22,7 @@ namespace needle {
 namespace {
 
 struct BenchOptions {
-  std::string out_dir, needles = "SB,AMB", levels = "full,projection,fast";
+  std::string out_dir, needles = "SB,LMB,AMB,HMB", levels = "full,projection,fast";
   std::string scene = std::string(NEEDLE_DATA_DIR) + "/scenes/bench_insertion_10mm.json";
   std::string reference = std::string(NEEDLE_DATA_DIR) + "/bench/insertion_reference_10mm.json";
   bool quiet = false;
@@ -104,7 +104,7 @@ void add_bench_command(CLI::App& app) {
                    "report time, steps, deflection, its error against a stored converged reference and against the full model, "
                    "penetration and energy error: speed_error.csv, .json and .png (a finished case folder is reused)");
   c->add_option("--out", o->out_dir, "Folder for the case runs and the report")->required();
-  c->add_option("--needles", o->needles, "Comma-separated presets (default SB,AMB)");
+  c->add_option("--needles", o->needles, "Comma-separated presets (default SB,LMB,AMB,HMB: the four the stored reference holds)");
   c->add_option("--levels", o->levels, fmt::format("Comma-separated model levels (default full,projection,fast; known: {})", levels));
   c->add_option("--scene", o->scene, "The scene (default data/scenes/bench_insertion_10mm.json)");
   c->add_option("--reference", o->reference,

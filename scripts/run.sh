@@ -25,8 +25,8 @@ done
 ./build/bench/bench_spg | tee out/bench_spg.txt
 ./build/bench/bench_needle | tee out/bench_needle.txt
 ./build/bench/bench_insertion | tee out/bench_insertion.txt
-# Speed against error of the fast model level (the default), SB and AMB 10 mm into the bench scene, against the stored
-# reference (under a minute; the full and projection levels' runs, about 20 and 7 min a needle, are stored in
+# Speed against error of the fast model level (the default), the four needles 10 mm into the bench scene, against the
+# stored reference (about a minute; the full and projection levels' runs, a few minutes a needle, are stored in
 # docs/notebook/paper_results/bench_insertion_10mm/: `needle bench insertion --out DIR` runs all three).
 ./build/apps/needle bench insertion --levels fast --out out/bench_levels --quiet
 cat out/bench_levels/speed_error.csv
