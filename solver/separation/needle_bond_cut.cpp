@@ -2,82 +2,20 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <nlohmann/json.hpp>
 
 #include "core/parallel.h"
+#include "solver/separation/needle_cut_grid.h"
 
 namespace needle {
-
-// The needle's current triangles (for a half model with the mirror images of those that touch the
-// symmetry plane) binned in a uniform grid over their bounding box: CSR over cells.
-struct NeedleBondCut::Grid {
-  // A triangle as the segment test reads it: a corner, its two edges from there, the product of their lengths
-  // (the scale of the test for parallel segments) and its bounding box, widened by the test's tolerance.
-  struct Triangle {
-    Eigen::Vector3d v0, e1, e2, lo, hi;
-    double edge_lengths = 0;
-  };
-  std::vector<Triangle> triangles;
-  Eigen::Vector3d lo = Eigen::Vector3d::Zero(), hi = Eigen::Vector3d::Zero();
-  Eigen::Vector3i cells = Eigen::Vector3i::Zero();
-  double cell_mm = 1;
-  std::vector<int> start, entries;
-  std::vector<std::uint8_t> near;  // per cell: 1 when the cell or one of its 26 neighbours holds a triangle
-  std::uint64_t mirrored_signature = 0;  // which triangles a half model mirrors (a hash of their indices)
-
-  Eigen::Vector3i cell_of(const Eigen::Vector3d& p) const {
-    Eigen::Vector3i c = ((p - lo) / cell_mm).array().floor().cast<int>();
-    return c.cwiseMax(0).cwiseMin(cells - Eigen::Vector3i::Ones());
-  }
-  int index(int i, int j, int k) const { return (i * cells.y() + j) * cells.z() + k; }
-};
 
 namespace {
 
 Eigen::Vector3d everywhere_lo() { return Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity()); }
 Eigen::Vector3d everywhere_hi() { return Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()); }
-
-constexpr double kBarycentricTolerance = 1e-9;  // a segment through a shared edge or the seam still hits
-constexpr double kDistinctCrossing = 1e-7;      // crossings closer than this (in s) are the same point
-
-constexpr double kBoxSlackMm = 1e-6;            // a triangle's box is widened by this before the exact test
-
-// The certificates (see the header): the box they look within is widened along each axis by the needle's motion there
-// over kCertificateSteps steps, at least kMinDilationMm and at most kMaxDilationMm; no gap exceeds the latter, and the
-// grid holds the triangles within that of the particles' box, so a triangle left out lies apart by more. Gaps are
-// taken kCertificateSafetyMm short (rounding at the cells' faces); the tissue's own motion, which the needle's does
-// not bound, counts as kParticleRateMm a step when the longest-lasting gaps are chosen.
-constexpr double kCertificateSteps = 8;
-constexpr double kMinDilationMm = 0.01;
-constexpr double kMaxDilationMm = 0.1;
-constexpr double kCertificateSafetyMm = 1e-9;
-constexpr double kParticleRateMm = 1e-4;
-constexpr double kPlaneSafetyMm = 1e-6;  // a segment this near a triangle's plane gets no certificate from it
-
-// Parameter s in [0, 1] where a + s (b - a) meets triangle t (Moeller-Trumbore), or NaN; length = |b - a|.
-template <class Triangle>
-double segment_triangle(const Eigen::Vector3d& a, const Eigen::Vector3d& d, double length, const Triangle& t) {
-  const Eigen::Vector3d& e1 = t.e1;
-  const Eigen::Vector3d& e2 = t.e2;
-  const Eigen::Vector3d q = d.cross(e2);
-  const double det = e1.dot(q);
-  const double scale = t.edge_lengths * length;
-  if (!(std::abs(det) > 1e-12 * scale)) return std::nan("");  // parallel to the triangle's plane
-  const double inv = 1.0 / det;
-  const Eigen::Vector3d w = a - t.v0;
-  const double u = w.dot(q) * inv;
-  if (u < -kBarycentricTolerance || u > 1 + kBarycentricTolerance) return std::nan("");
-  const Eigen::Vector3d r = w.cross(e1);
-  const double v = d.dot(r) * inv;
-  if (v < -kBarycentricTolerance || u + v > 1 + kBarycentricTolerance) return std::nan("");
-  const double s = e2.dot(r) * inv;
-  if (s < -kBarycentricTolerance || s > 1 + kBarycentricTolerance) return std::nan("");
-  return std::clamp(s, 0.0, 1.0);
-}
 
 }  // namespace
 
@@ -99,8 +37,8 @@ NeedleBondCut::Grid NeedleBondCut::build_grid(const Eigen::MatrixX3d& needle_x, 
     t.e1 = v[1] - v[0];
     t.e2 = v[2] - v[0];
     t.edge_lengths = t.e1.norm() * t.e2.norm();
-    t.lo = v[0].cwiseMin(v[1]).cwiseMin(v[2]).array() - kBoxSlackMm;
-    t.hi = v[0].cwiseMax(v[1]).cwiseMax(v[2]).array() + kBoxSlackMm;
+    t.lo = v[0].cwiseMin(v[1]).cwiseMin(v[2]).array() - needle_cut::kBoxSlackMm;
+    t.hi = v[0].cwiseMax(v[1]).cwiseMax(v[2]).array() + needle_cut::kBoxSlackMm;
     if ((t.hi.array() < clip_lo.array()).any() || (t.lo.array() > clip_hi.array()).any()) return false;
     grid.triangles.push_back(t);
     return true;
@@ -181,18 +119,12 @@ void NeedleBondCut::for_each_hit(const Grid& grid, const Eigen::Vector3d& a, con
   if ((c1 - c0).maxCoeff() <= 1 && !grid.near[static_cast<size_t>(grid.index(c0.x(), c0.y(), c0.z()))]) return;
   const Eigen::Vector3d d = b - a;
   const double length = d.norm();
-  for (int i = c0.x(); i <= c1.x(); ++i)
-    for (int j = c0.y(); j <= c1.y(); ++j)
-      for (int k = c0.z(); k <= c1.z(); ++k) {
-        const int cell = grid.index(i, j, k);
-        for (int e = grid.start[static_cast<size_t>(cell)]; e < grid.start[static_cast<size_t>(cell + 1)]; ++e) {
-          const Grid::Triangle& t = grid.triangles[static_cast<size_t>(grid.entries[static_cast<size_t>(e)])];
-          if ((hi.array() < t.lo.array()).any() || (lo.array() > t.hi.array()).any()) continue;  // boxes apart: no hit
-          if (overlapped) *overlapped = true;
-          const double hit = segment_triangle(a, d, length, t);
-          if (!std::isnan(hit) && !visit(hit)) return;
-        }
-      }
+  needle_cut::for_each_triangle_in_cells(grid, c0, c1, [&](const Grid::Triangle& t) {
+    if ((hi.array() < t.lo.array()).any() || (lo.array() > t.hi.array()).any()) return true;  // boxes apart: no hit
+    if (overlapped) *overlapped = true;
+    const double hit = needle_cut::segment_triangle(a, d, length, t);
+    return std::isnan(hit) || visit(hit);
+  });
 }
 
 std::vector<double> NeedleBondCut::crossings(const Grid& grid, const Eigen::Vector3d& a, const Eigen::Vector3d& b) const {
@@ -202,19 +134,19 @@ std::vector<double> NeedleBondCut::crossings(const Grid& grid, const Eigen::Vect
     return true;
   });
   std::sort(s.begin(), s.end());
-  s.erase(std::unique(s.begin(), s.end(), [](double x, double y) { return y - x < kDistinctCrossing; }), s.end());
+  s.erase(std::unique(s.begin(), s.end(), [](double x, double y) { return y - x < needle_cut::kDistinctCrossing; }), s.end());
   return s;
 }
 
 bool NeedleBondCut::passes_through(const Grid& grid, const Eigen::Vector3d& a, const Eigen::Vector3d& b) const {
-  // crossings() merges each hit into the last one it kept when they are closer than kDistinctCrossing, so it
+  // crossings() merges each hit into the last one it kept when they are closer than needle_cut::kDistinctCrossing, so it
   // finds two distinct points exactly when its highest and lowest hits lie that far apart: the walk stops there.
   double lowest = std::numeric_limits<double>::infinity(), highest = -lowest;
   bool two = false;
   for_each_hit(grid, a, b, [&](double hit) {
     lowest = std::min(lowest, hit);
     highest = std::max(highest, hit);
-    two = highest - lowest >= kDistinctCrossing;
+    two = highest - lowest >= needle_cut::kDistinctCrossing;
     return !two;
   });
   return two;
@@ -227,129 +159,10 @@ bool NeedleBondCut::passes_through(const Grid& grid, const Eigen::Vector3d& a, c
   for_each_hit(grid, a, b, [&](double hit) {
     lowest = std::min(lowest, hit);
     highest = std::max(highest, hit);
-    two = highest - lowest >= kDistinctCrossing;
+    two = highest - lowest >= needle_cut::kDistinctCrossing;
     return !two;
   }, &overlapped);
   return two;
-}
-
-namespace {
-
-// See passes_through_or_certify: whether the segment a-b lies on one side of the triangle's plane by more than
-// kPlaneSafetyMm, and if so the gaps lowered so that their motion along its normal stays below that distance.
-template <class Triangle>
-bool certify_by_plane(const Triangle& t, const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& speed,
-                      Eigen::Vector3d& gap) {
-  const Eigen::Vector3d normal = t.e1.cross(t.e2);
-  const double norm = normal.norm();
-  if (!(norm > 0)) return false;
-  const Eigen::Vector3d unit = normal / norm;
-  const double da = unit.dot(a - t.v0), db = unit.dot(b - t.v0);
-  const double distance = da > 0 && db > 0 ? std::min(da, db) : da < 0 && db < 0 ? std::min(-da, -db) : 0.0;
-  const double room = distance - kPlaneSafetyMm;
-  if (!(room > 0)) return false;
-  const Eigen::Vector3d weight = unit.cwiseAbs();
-  const double along = weight.dot(gap);
-  if (along <= room) return true;
-  Eigen::Vector3d best = gap * (room / along);
-  double best_steps = best.cwiseQuotient(speed).minCoeff();
-  for (int axis = 0; axis < 3; ++axis) {
-    if (!(weight[axis] > 0)) continue;
-    Eigen::Vector3d lowered = gap;
-    lowered[axis] = (room - (along - weight[axis] * gap[axis])) / weight[axis];
-    if (!(lowered[axis] > 0)) continue;
-    const double steps = lowered.cwiseQuotient(speed).minCoeff();
-    if (steps > best_steps) {
-      best_steps = steps;
-      best = lowered;
-    }
-  }
-  gap = best;
-  return true;
-}
-
-}  // namespace
-
-bool NeedleBondCut::passes_through_or_certify(const Grid& grid, const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& dilation,
-                                              const Eigen::Vector3d& rate, Eigen::Vector3d& gap) const {
-  const Eigen::Vector3d lo = a.cwiseMin(b), hi = a.cwiseMax(b);
-  const auto finish = [&gap](bool certified) {
-    if (certified) gap.array() -= kCertificateSafetyMm;
-    else gap.setZero();
-    return false;
-  };
-  // Wholly beside the grid's box along an axis: every triangle's box lies at least that far apart along it.
-  gap.setConstant(kMaxDilationMm);
-  bool outside = false;
-  for (int k = 0; k < 3; ++k) {
-    const double apart = std::max(grid.lo[k] - hi[k], lo[k] - grid.hi[k]);
-    if (apart > 0) {
-      gap[k] = std::min(gap[k], apart);
-      outside = true;
-    }
-  }
-  if (outside) return finish(true);
-  const Eigen::Vector3i c0 = grid.cell_of(lo), c1 = grid.cell_of(hi);
-  if ((c1 - c0).maxCoeff() <= 1 && !grid.near[static_cast<size_t>(grid.index(c0.x(), c0.y(), c0.z()))]) {
-    // No triangle in the 27 cells around c0, which hold the segment: every triangle's box lies beyond a face of that
-    // block, so apart along that face's axis by at least the segment's distance to it (a side the grid ends on has none).
-    for (int k = 0; k < 3; ++k) {
-      double apart = kMaxDilationMm;
-      if (c0[k] > 0) apart = std::min(apart, lo[k] - (grid.lo[k] + (c0[k] - 1) * grid.cell_mm));
-      if (c0[k] + 1 < grid.cells[k] - 1) apart = std::min(apart, grid.lo[k] + (c0[k] + 2) * grid.cell_mm - hi[k]);
-      gap[k] = apart;
-    }
-    return finish(true);
-  }
-  // The triangles whose boxes overlap the segment's are tested as passes_through tests them; the others lie apart
-  // along some axis, and each lowers the gap along one axis to its own separation there unless it is already
-  // covered: the axis whose lowered gaps last the most steps at the rates given.
-  gap = dilation.cwiseMin(Eigen::Vector3d::Constant(kMaxDilationMm));
-  const Eigen::Vector3d speed = rate.cwiseMax(Eigen::Vector3d::Constant(kParticleRateMm));
-  const Eigen::Vector3i d0 = grid.cell_of(lo - gap), d1 = grid.cell_of(hi + gap);
-  const Eigen::Vector3d d = b - a;
-  const double length = d.norm();
-  double lowest = std::numeric_limits<double>::infinity(), highest = -lowest;
-  bool certified = true;
-  for (int i = d0.x(); i <= d1.x(); ++i)
-    for (int j = d0.y(); j <= d1.y(); ++j)
-      for (int k = d0.z(); k <= d1.z(); ++k) {
-        const int cell = grid.index(i, j, k);
-        for (int e = grid.start[static_cast<size_t>(cell)]; e < grid.start[static_cast<size_t>(cell + 1)]; ++e) {
-          const Grid::Triangle& t = grid.triangles[static_cast<size_t>(grid.entries[static_cast<size_t>(e)])];
-          const Eigen::Vector3d apart = (t.lo - hi).cwiseMax(lo - t.hi);
-          if ((apart.array() > 0).any()) {  // boxes apart: no hit
-            if (!certified || (apart.array() >= gap.array()).any()) continue;
-            int best = -1;
-            double best_steps = -1;
-            for (int axis = 0; axis < 3; ++axis) {
-              if (!(apart[axis] > 0)) continue;
-              Eigen::Vector3d lowered = gap;
-              lowered[axis] = apart[axis];
-              const double steps = lowered.cwiseQuotient(speed).minCoeff();
-              if (steps > best_steps) {
-                best_steps = steps;
-                best = axis;
-              }
-            }
-            gap[best] = apart[best];
-            continue;
-          }
-          // Boxes overlapping: a segment wholly on one side of the triangle's plane cannot meet it, and stays apart while
-          // the motion along the plane's normal (at most the sum of |n_k| times the motion along each axis) is less
-          // than its nearer end's distance to the plane: the gaps are lowered until that sum is (one axis, or all in
-          // proportion, whichever lasts the most steps). Such a triangle is not hit now either: its exact test finds
-          // nothing (the distance is far above the test's tolerance) and is left out.
-          if (certified && certify_by_plane(t, a, b, speed, gap)) continue;
-          certified = false;
-          const double hit = segment_triangle(a, d, length, t);
-          if (std::isnan(hit)) continue;
-          lowest = std::min(lowest, hit);
-          highest = std::max(highest, hit);
-          if (highest - lowest >= kDistinctCrossing) return true;
-        }
-      }
-  return finish(certified);
 }
 
 std::vector<double> NeedleBondCut::surface_crossings(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
@@ -357,7 +170,7 @@ std::vector<double> NeedleBondCut::surface_crossings(const Eigen::Vector3d& a, c
   return crossings(build_grid(needle_x, everywhere_lo(), everywhere_hi()), a, b);
 }
 
-namespace {
+namespace needle_cut {
 
 // Each particle's side of the box [lo, hi] along each axis (bit 2k: below it on axis k, bit 2k + 1: above): a segment
 // whose two ends share a bit lies wholly on that side, which is for_each_hit's first test.
@@ -377,12 +190,12 @@ std::vector<std::uint8_t> box_sides(const std::vector<Vec3d>& x, const Eigen::Ve
   return side;
 }
 
-}  // namespace
+}  // namespace needle_cut
 
 std::vector<std::int64_t> NeedleBondCut::scan(const Grid& grid, const IntactPair* pairs, std::int64_t count, const BondNetwork& bonds,
                                               const std::vector<Vec3d>& x) const {
   // Most bonds are rejected by their sides alone, without their positions.
-  const std::vector<std::uint8_t> side = box_sides(x, grid.lo, grid.hi);
+  const std::vector<std::uint8_t> side = needle_cut::box_sides(x, grid.lo, grid.hi);
   // The arrays are read through local pointers: the compiler cannot tell that appending a find leaves the lists'
   // addresses be, so it would reload them for every pair.
   return parallel_collect_chunks<std::int64_t>(count, [&](std::int64_t begin, std::int64_t end, std::vector<std::int64_t>& found) {
@@ -395,84 +208,6 @@ std::vector<std::int64_t> NeedleBondCut::scan(const Grid& grid, const IntactPair
       if (!all[pair.bond].broken && passes_through(grid, positions[pair.i], positions[pair.j])) found.push_back(pair.bond);
     }
   });
-}
-
-std::vector<std::int64_t> NeedleBondCut::scan_certified(const Grid& grid, const BondNetwork& bonds, const std::vector<Vec3d>& x) {
-  const std::vector<std::uint8_t> side = box_sides(x, grid.lo, grid.hi);
-  const std::int32_t now_index = static_cast<std::int32_t>(needle_motion_.size() - 1);
-  const Eigen::Vector3d now = needle_motion_.back();
-  const Eigen::Vector3d rate = needle_motion_.size() > 1 ? Eigen::Vector3d(now - needle_motion_[needle_motion_.size() - 2]) : Eigen::Vector3d::Zero();
-  const Eigen::Vector3d dilation = (kCertificateSteps * rate).cwiseMax(Eigen::Vector3d::Constant(kMinDilationMm));
-  std::atomic<std::int64_t> made{0}, skipped{0};
-  std::vector<std::int64_t> found_all = parallel_collect_chunks<std::int64_t>(
-      static_cast<std::int64_t>(candidates_.size()), [&](std::int64_t begin, std::int64_t end, std::vector<std::int64_t>& found) {
-        const Bond* const all = bonds.bonds.data();
-        const std::uint8_t* const sides = side.data();
-        const Vec3d* const positions = x.data();
-        const IntactPair* const pairs = candidates_.data();
-        Certificate* const certificates = certificates_.data();
-        std::int64_t chunk_made = 0, chunk_skipped = 0;
-        for (std::int64_t k = begin; k < end; ++k) {
-          const IntactPair pair = pairs[k];
-          if (sides[pair.i] & sides[pair.j]) continue;
-          if (all[pair.bond].broken) continue;
-          const Vec3d& a = positions[pair.i];
-          const Vec3d& b = positions[pair.j];
-          Certificate& c = certificates[k];
-          if (c.gap[0] > 0 && c.gap[1] > 0 && c.gap[2] > 0) {
-            const Eigen::Vector3d& then = needle_motion_[static_cast<size_t>(c.motion_index)];
-            bool holds = true;
-            for (int axis = 0; axis < 3 && holds; ++axis) {
-              const double moved = std::max(std::abs(a[axis] - c.a[axis]), std::abs(b[axis] - c.b[axis])) + (now[axis] - then[axis]);
-              holds = moved < c.gap[axis];
-            }
-            if (holds) {
-              ++chunk_skipped;
-              continue;
-            }
-          }
-          ++chunk_made;
-          // A bond whose box overlapped a triangle's at its last test most likely does again: the plain walk first.
-          if (c.gap[0] < 0) {
-            bool overlapped = false;
-            if (passes_through(grid, a, b, overlapped)) {
-              found.push_back(pair.bond);
-              continue;
-            }
-            if (overlapped) continue;
-          }
-          Eigen::Vector3d gap;
-          if (passes_through_or_certify(grid, a, b, dilation, rate, gap)) {
-            found.push_back(pair.bond);
-            continue;
-          }
-          if (!(gap.array() > 0).all()) {  // no certificate: a box overlapped (or a gap closed to nothing)
-            c.gap[0] = c.gap[1] = c.gap[2] = -1;
-            continue;
-          }
-          for (int axis = 0; axis < 3; ++axis) {
-            c.a[axis] = a[axis];
-            c.b[axis] = b[axis];
-            c.gap[axis] = gap[axis];
-          }
-          c.motion_index = now_index;
-        }
-        made += chunk_made;
-        skipped += chunk_skipped;
-      });
-  tests_made_ += made;
-  tests_skipped_ += skipped;
-  return found_all;
-}
-
-void NeedleBondCut::track_needle_motion(const Eigen::MatrixX3d& needle_x, std::uint64_t mirrored_signature) {
-  const bool same_needle = last_needle_x_.rows() == needle_x.rows() && !needle_motion_.empty();
-  if (same_needle) needle_motion_.push_back(needle_motion_.back() + (needle_x - last_needle_x_).cwiseAbs().colwise().maxCoeff().transpose());
-  else needle_motion_.assign(1, Eigen::Vector3d::Zero());
-  last_needle_x_ = needle_x;
-  if (!same_needle || mirrored_signature != mirrored_signature_)
-    for (Certificate& c : certificates_) c.gap[0] = c.gap[1] = c.gap[2] = 0;  // none, and no overlap known
-  mirrored_signature_ = mirrored_signature;
 }
 
 std::vector<std::int64_t> NeedleBondCut::bonds_through_needle(const BondNetwork& bonds, const std::vector<Vec3d>& x,
@@ -495,8 +230,8 @@ std::vector<std::int64_t> NeedleBondCut::bonds_through_needle_tracked(const Bond
     particles_hi = particles_hi.cwiseMax(x[i]);
     if (still) still = (x[i] - listed_x_[i]).cwiseAbs().maxCoeff() < half;
   }
-  // With certificates the grid also holds the triangles within reach of a gap (see kMaxDilationMm).
-  const double reach = certify_ ? kMaxDilationMm : 0.0;
+  // With certificates the grid also holds the triangles within reach of a gap (kCertificateReachMm).
+  const double reach = certify_ ? kCertificateReachMm : 0.0;
   const Grid grid = build_grid(needle_x, particles_lo.array() - reach, particles_hi.array() + reach);
   if (certify_) track_needle_motion(needle_x, grid.mirrored_signature);
   if (!(margin_mm_ > 0)) return scan(grid, bonds.intact.data(), static_cast<std::int64_t>(bonds.intact.size()), bonds, x);
@@ -507,7 +242,7 @@ std::vector<std::int64_t> NeedleBondCut::bonds_through_needle_tracked(const Bond
   if (!valid) {
     list_lo_ = grid.lo.array() - margin_mm_;
     list_hi_ = grid.hi.array() + margin_mm_;
-    const std::vector<std::uint8_t> side = box_sides(x, list_lo_, list_hi_);
+    const std::vector<std::uint8_t> side = needle_cut::box_sides(x, list_lo_, list_hi_);
     const IntactPair* const pairs = bonds.intact.data();
     const Bond* const all = bonds.bonds.data();
     candidates_ = parallel_collect_chunks<IntactPair>(static_cast<std::int64_t>(bonds.intact.size()),

@@ -80,8 +80,12 @@ class NeedleBondCut : public SeparationModel {
   // (for tests and diagnostics).
   std::vector<double> surface_crossings(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::MatrixX3d& needle_x) const;
 
- private:
+  // The searches' grid of the needle's current triangles (solver/separation/needle_cut_grid.h).
   struct Grid;
+
+ private:
+  // How far beyond the particles' box the grid holds triangles when certificates are kept: no gap exceeds it.
+  static constexpr double kCertificateReachMm = 0.1;
   // The grid of the needle's triangles that reach into [clip_lo, clip_hi] (the segments tested lie there).
   Grid build_grid(const Eigen::MatrixX3d& needle_x, const Eigen::Vector3d& clip_lo, const Eigen::Vector3d& clip_hi) const;
   // Calls visit(s) for each hit of the segment a-b with a triangle, in no particular order, until visit returns false;
