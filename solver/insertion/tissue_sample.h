@@ -14,9 +14,8 @@
 //   floor_layer_length_mm, floor_layer_covered_mm: the same two for the captured particles of the floor's nearest layer,
 //                    by geometry: the centre within the contact's skin and a quarter of its spacing of the floor (the
 //                    contact holds a resting particle at the skin; the next layer lies a spacing higher). The kinematic
-//                    contact lists a particle
-//                    as touching only in a step it pushes it back, so a sample resting on the floor is counted by a
-//                    few of its particles at a time; the layer counts all of them;
+//                    contact lists a particle as touching only in a step it pushes it back, so a sample resting on the
+//                    floor is counted by a few of its particles at a time; the layer counts all of them;
 //   volume_mm3, mass_g: the captured particles' reference volume and (physical) mass.
 #include <Eigen/Dense>
 #include <cstdint>
