@@ -183,6 +183,63 @@ overclaimed = gs.kriging_surrogate(design, [dict(r, ratio_LMB=r["ratio_LMB"] + n
 check(not overclaimed["validated"],
       f"runs four times noisier than the replicas say are not validated (LOO RMSE {overclaimed['leave_one_out_rmse']:.3f}, Q2 {overclaimed['leave_one_out_q2']:.2f})")
 
+# Replicas: each point run again with scene keys set on top (the lattice shifted). The plain batch's sweep file is the
+# same with or without them; a replica's adds its keys and keeps the labels; a response is the mean of a point's
+# complete runs; the scatter between a point's own runs, pooled, recovers a known noise; the kriging given it smooths
+# the means and is validated.
+replicated = dict(study, batch_points=32, replicas=[{"name": "y0.1", "set": {"tissue.offset_y_mm": 0.1}}])
+plain_study = dict(study, batch_points=32)
+with tempfile.TemporaryDirectory() as tmp:
+    check(gs.sweep_file(replicated, 0) == gs.sweep_file(plain_study, 0), "replicas leave the plain batch's sweep file as it was")
+    shifted_file = gs.sweep_file(replicated, 0, "y0.1")
+    check(shifted_file["set"] == dict(study.get("set", {}), **{"tissue.offset_y_mm": 0.1})
+          and [c["label"] for c in shifted_file["design"]["cases"]] == [c["label"] for c in gs.sweep_file(plain_study, 0)["design"]["cases"]],
+          "a replica's sweep file sets its keys on top of the study's and keeps the points' labels")
+    path = gs.write_batch(replicated, tmp, 0, "y0.1")
+    count = subprocess.run([needle, "sweep", path, "--count"], capture_output=True, text=True)
+    check(path.endswith(os.path.join("batch_0_y0.1", "sweep.json")) and count.returncode == 0 and count.stdout.strip() == str(32 * len(study["needles"])),
+          f"needle sweep --count accepts the replica's sweep file ({count.stdout.strip()} cases{', ' + count.stderr.strip() if count.stderr else ''})")
+    gs.write_batch(replicated, tmp, 0)
+    rng = random.Random(11)
+    drawn = {}
+    for replica in gs.replica_names(replicated):
+        for index, (point, needle_name, values) in enumerate(gs.batch_cases(replicated, 0)):
+            case_dir = os.path.join(gs.batch_folder(tmp, 0, replica), "sweep", "cases", f"case_{index:04d}")
+            os.makedirs(case_dir)
+            deflection, ratio = truth(values)
+            if needle_name == "LMB":  # the ratio itself carries the noise: SD 0.05
+                drawn[(point, replica)] = ratio["LMB"] + rng.gauss(0.0, 0.05)
+                deflection["LMB"] = drawn[(point, replica)] * deflection["SB"]
+            record = {"label": f"point {point:03d} {needle_name}", "status": "finished", "deflection_mm": deflection[needle_name],
+                      "groove_fill": 0.9, "runtime_s": 1.0}
+            if replica and point == 7 and needle_name == "AMB":  # the replica of point 7 stops: the plain run stands alone
+                record = {"label": record["label"], "status": "stopped", "reason": "energy drift", "deflection_mm": None}
+            with open(os.path.join(case_dir, "case.json"), "w") as f:
+                json.dump(record, f)
+    rows, incomplete = gs.complete_rows(replicated, gs.read_points(replicated, tmp))
+    row3 = next(r for r in rows if r["point"] == 3)
+    row7 = next(r for r in rows if r["point"] == 7)
+    check(len(rows) == 32 and not incomplete and row3["runs"] == 2 and row7["runs"] == 1,
+          f"a point counts its complete runs (point 3: {row3['runs']}, point 7 with its replica stopped: {row7['runs']})")
+    check(abs(row3["ratio_LMB"] - (drawn[(3, "")] + drawn[(3, "y0.1")]) / 2) < 1e-12 and abs(row7["ratio_LMB"] - drawn[(7, "")]) < 1e-12
+          and row3["ratio_LMB@y0.1"] == row3["ratio_LMB@y0.1"] and row7["ratio_LMB@y0.1"] is None,
+          "a response is the mean of the point's complete runs, each run's kept beside")
+    within = gs.within_point_scatter(replicated, rows)
+    sd_lmb, dof_lmb = within["ratio_LMB"]
+    check(dof_lmb == 31 and abs(sd_lmb - 0.05) < 0.3 * 0.05 and within["ratio_HMB"][0] < 1e-9,
+          f"the scatter within points recovers the noise (ratio_LMB {sd_lmb:.4f} with {dof_lmb} dof against 0.05; a noiseless ratio {within['ratio_HMB'][0]:.1e})")
+    means = gs.kriging_surrogate(replicated, rows, "ratio_LMB", ["groove_start_mm", "friction"], noise_sd=sd_lmb)
+    check(abs(means["data_sd"] - sd_lmb * ((31 / 2 + 1) / 32) ** 0.5) < 1e-12,
+          f"the means' noise is one run's over the square root of the runs they average ({means['data_sd']:.4f})")
+    check(means["validated"] and abs(means["box_min"]["value"] - (-0.5)) < 0.05 and abs(means["box_max"]["value"] - 0.1) < 0.05,
+          f"replicated runs: the kriging of the means is validated and finds the function's extremes (LOO RMSE {means['leave_one_out_rmse']:.3f}, "
+          f"{means['box_min']['value']:+.3f}..{means['box_max']['value']:+.3f} against -0.5..+0.1)")
+    result = gs.analyze(replicated, tmp, permutations=200)
+    check(abs(result["within_point_sd"]["ratio_LMB"]["sd"] - sd_lmb) < 1e-12 and abs(result["replica_sd"]["ratio_LMB"] - sd_lmb) < 1e-12,
+          "the analysis takes the scatter within points as the runs' noise")
+    with open(os.path.join(tmp, "analysis", "hsic.md")) as f:
+        check("share of the runs' variance within points" in f.read(), "the analysis's tables show the scatter within points")
+
 # One more parameter fitted honestly (second_parameter.py): ratios linear in the value, so every fit has a closed form.
 import second_parameter as sp  # noqa: E402
 
@@ -253,6 +310,13 @@ with tempfile.TemporaryDirectory() as tmp:
         json.dump({"needles": ["SB"], "factors": [{"name": "a", "key": "tissue.friction", "range": [0.3, 0.1]}], "batch_points": 4}, f)
     r = subprocess.run([sys.executable, script, "--study", bad, "--out", os.path.join(tmp, "o"), "--design-only"], capture_output=True, text=True)
     check(r.returncode == 2 and "lo < hi" in r.stderr, f"an empty range is refused ({r.stderr.strip()})")
+
+    with open(bad, "w") as f:
+        json.dump({"needles": ["SB"], "factors": [{"name": "a", "key": "tissue.friction", "range": [0.1, 0.3]}], "batch_points": 4,
+                   "replicas": [{"name": "f", "set": {"tissue.friction": 0.2}}]}, f)
+    r = subprocess.run([sys.executable, script, "--study", bad, "--out", os.path.join(tmp, "o"), "--design-only"], capture_output=True, text=True)
+    check(r.returncode == 2 and "tissue.friction" in r.stderr and not os.path.exists(os.path.join(tmp, "o")),
+          f"a replica that moves a factor is refused ({r.stderr.strip()})")
 
 print(f"{len(failures)} failed" if failures else "all passed")
 sys.exit(1 if failures else 0)

@@ -1,0 +1,152 @@
+"""The global sensitivity study's design (studies/sensitivity/global_sensitivity.py): the study file, its factors and
+replicas, the Sobol' points of each batch, and each batch's sweep file for `needle sweep`."""
+import json
+import os
+import re
+
+
+class StudyError(Exception):
+    pass
+
+
+def read_study(path):
+    try:
+        with open(path) as f:
+            study = json.load(f)
+    except (OSError, json.JSONDecodeError) as e:
+        raise StudyError(f"{path}: {e}")
+    for key in ("needles", "factors", "batch_points"):
+        if key not in study:
+            raise StudyError(f"{path}: missing '{key}'")
+    if "SB" not in study["needles"]:
+        raise StudyError(f"{path}: the needles must include SB (the ratios are to SB)")
+    names = set()
+    for f in study["factors"]:
+        if not isinstance(f, dict) or "name" not in f or "key" not in f:
+            raise StudyError(f"{path}: each factor needs a 'name' and a scene 'key'")
+        if f["name"] in names:
+            raise StudyError(f"{path}: factor '{f['name']}' appears twice")
+        names.add(f["name"])
+        if ("range" in f) == ("levels" in f):
+            raise StudyError(f"{path}: factor '{f['name']}' needs either 'range' [lo, hi] or 'levels' [...]")
+        if "range" in f and not (len(f["range"]) == 2 and f["range"][0] < f["range"][1]):
+            raise StudyError(f"{path}: factor '{f['name']}': 'range' must be [lo, hi] with lo < hi")
+        if "levels" in f and len(f["levels"]) < 2:
+            raise StudyError(f"{path}: factor '{f['name']}': give at least two levels")
+    if not (isinstance(study["batch_points"], int) and study["batch_points"] >= 2):
+        raise StudyError(f"{path}: 'batch_points' must be an integer of at least 2")
+    factor_keys = {f["key"] for f in study["factors"]}
+    replica_names = set()
+    for r in study.get("replicas", []):
+        if not isinstance(r, dict) or not isinstance(r.get("name"), str) or not re.fullmatch(r"[A-Za-z0-9.+_-]+", r["name"]):
+            raise StudyError(f"{path}: each replica needs a 'name' of letters, digits and . + _ - (it names a folder)")
+        if r["name"] in replica_names:
+            raise StudyError(f"{path}: replica '{r['name']}' appears twice")
+        replica_names.add(r["name"])
+        if not isinstance(r.get("set"), dict) or not r["set"]:
+            raise StudyError(f"{path}: replica '{r['name']}' needs a 'set' of scene keys")
+        moved = sorted(factor_keys & set(r["set"]))
+        if moved:
+            raise StudyError(f"{path}: replica '{r['name']}' sets {moved[0]}, a factor of the study: a replica repeats the design, it does not move it")
+    return study
+
+
+def replica_names(study):
+    """The design's runs: the plain one (named "") and each replica (the same points run again with the replica's scene
+    keys set on top: the lattice shifted, so that each point's own run-to-run scatter is measured)."""
+    return [""] + [r["name"] for r in study.get("replicas", [])]
+
+
+def replica_set(study, name):
+    return next(r["set"] for r in study.get("replicas", []) if r["name"] == name) if name else {}
+
+
+def unit_design(dimension, count):
+    """The first `count` points of the Sobol' sequence in [0, 1)^dimension (the same for every run and machine)."""
+    import openturns as ot
+    sample = ot.SobolSequence(dimension).generate(count)
+    return [[float(v) for v in row] for row in sample]
+
+
+def factor_value(factor, u):
+    """The factor's value at the unit coordinate u: a range is mapped linearly, levels take equal shares of [0, 1)."""
+    if "range" in factor:
+        lo, hi = factor["range"]
+        return float(f"{lo + u * (hi - lo):.6g}")
+    levels = factor["levels"]
+    return levels[min(int(u * len(levels)), len(levels) - 1)]
+
+
+def numeric(factor, value):
+    """A factor's value as a number for the statistics: a level by its index."""
+    if "range" in factor:
+        return float(value)
+    return float(factor["levels"].index(value))
+
+
+def unit_coordinate(factor, value):
+    """A factor's value scaled to [0, 1]: over its range, or its level's index over the levels."""
+    if "range" in factor:
+        lo, hi = factor["range"]
+        return (float(value) - lo) / (hi - lo)
+    return factor["levels"].index(value) / (len(factor["levels"]) - 1)
+
+
+def value_at_unit(factor, u):
+    if "range" in factor:
+        lo, hi = factor["range"]
+        return lo + u * (hi - lo)
+    return factor["levels"][int(round(u * (len(factor["levels"]) - 1)))]
+
+
+def batch_cases(study, batch):
+    """The design points of one batch, each run on every needle: [(point index, needle, {key: value})]."""
+    n = study["batch_points"]
+    points = unit_design(len(study["factors"]), (batch + 1) * n)[batch * n:]
+    cases = []
+    for k, u in enumerate(points):
+        point = batch * n + k
+        values = {f["key"]: factor_value(f, uk) for f, uk in zip(study["factors"], u)}
+        for needle in study["needles"]:
+            cases.append((point, needle, values))
+    return cases
+
+
+def sweep_file(study, batch, replica=""):
+    cases = []
+    for point, needle, values in batch_cases(study, batch):
+        case = {"label": f"point {point:03d} {needle}", "needle.preset": needle}
+        case.update(values)
+        cases.append(case)
+    sweep = {"design": {"cases": cases}}
+    if study.get("model"):
+        sweep["model"] = study["model"]
+    fixed = dict(study.get("set", {}))
+    fixed.update(replica_set(study, replica))
+    if fixed:
+        sweep["set"] = fixed
+    return sweep
+
+
+def write_sweep_file(path, sweep):
+    """Writes a study's sweep file whole, or accepts the same one already there (a rerun); StudyError for another."""
+    text = json.dumps(sweep, indent=1) + "\n"
+    if os.path.exists(path):
+        with open(path) as f:
+            if f.read() != text:
+                raise StudyError(f"{path} holds another design (the study changed?): give a new --out")
+    else:
+        with open(path + ".tmp", "w") as f:
+            f.write(text)
+        os.replace(path + ".tmp", path)
+    return path
+
+
+def batch_folder(out, batch, replica=""):
+    return os.path.join(out, f"batch_{batch}" + (f"_{replica}" if replica else ""))
+
+
+def write_batch(study, out, batch, replica=""):
+    folder = batch_folder(out, batch, replica)
+    os.makedirs(folder, exist_ok=True)
+    return write_sweep_file(os.path.join(folder, "sweep.json"), sweep_file(study, batch, replica))
