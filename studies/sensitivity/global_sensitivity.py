@@ -34,7 +34,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from study_design import (StudyError, batch_cases, batch_folder, factor_value, numeric, read_study, replica_names,  # noqa: E402,F401
                           replica_set, sweep_file, unit_design, write_batch, write_sweep_file)
 from study_runs import (MEASURED_MM, PLATEAU, POOLED_SD_MM, case_records, complete_rows, read_points, replica_scatter,  # noqa: E402,F401
-                        responses, within_point_scatter)
+                        response_view, responses, within_point_scatter)
 from study_surrogates import (MIN_Q2, RMSE_OVER_SCATTER, chaos_or_none, hsic_indices, joint_search,  # noqa: E402,F401
                               kriging_surrogate)
 
@@ -99,10 +99,10 @@ def plot_hsic(path, study, table, response_names):
     fig, ax = plt.subplots(figsize=(11, 5.5))
     width = 0.8 / len(response_names)
     for k, resp in enumerate(response_names):
-        values = [table[resp][n][0] for n in names]
+        values = [table[resp][n][0] if n in table[resp] else 0.0 for n in names]  # a factor that cannot act on it: none
         ax.bar([i + k * width for i in range(len(names))], values, width, label=resp)
         for i, n in enumerate(names):
-            if table[resp][n][1] < 0.05:
+            if n in table[resp] and table[resp][n][1] < 0.05:
                 ax.text(i + k * width, values[i], "*", ha="center", va="bottom", fontsize=9)
     ax.set_xticks([i + 0.4 - width / 2 for i in range(len(names))])
     ax.set_xticklabels(names, rotation=40, ha="right", fontsize=8)
@@ -114,7 +114,7 @@ def plot_hsic(path, study, table, response_names):
     plt.close(fig)
 
 
-def plot_scatter(path, study, rows, table):
+def plot_scatter(path, study, views, table):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -123,8 +123,9 @@ def plot_scatter(path, study, rows, table):
     for i, resp in enumerate(ratios):
         top = sorted(table[resp].items(), key=lambda kv: -kv[1][0])[:3]
         needle = resp.split("_", 1)[1]
+        view_study, rows = views[resp]
         for j, (name, (r2, p)) in enumerate(top):
-            f = next(f for f in study["factors"] if f["name"] == name)
+            f = next(f for f in view_study["factors"] if f["name"] == name)
             ax = axes[i][j]
             ax.scatter([numeric(f, r[name]) for r in rows], [r[resp] for r in rows], s=14)
             ax.axhline(MEASURED_MM[needle] / MEASURED_MM["SB"], color="k", ls="--", lw=1, label="experiment")
@@ -151,18 +152,19 @@ def analyze(study, out, permutations=2000, top=3, root=None):
     if len(rows) < 4:
         raise StudyError(f"{len(rows)} complete design points in {out}: the analysis needs at least 4")
     resp = responses(study)
-    table = {r: {name: (r2, p) for name, r2, p in hsic_indices(study, rows, r, permutations)} for r in resp}
+    views = {r: response_view(study, rows, r) for r in resp}  # a factor acting within the lip clipped at each needle's lip
+    table = {r: {name: (r2, p) for name, r2, p in hsic_indices(*views[r], r, permutations)} for r in resp}
     with open(os.path.join(folder, "hsic.csv.tmp"), "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["factor"] + [x for r in resp for x in (f"{r}_r2hsic", f"{r}_p")])
         for fac in study["factors"]:
-            w.writerow([fac["name"]] + [f"{v:.6g}" for r in resp for v in table[r][fac["name"]]])
+            w.writerow([fac["name"]] + [f"{v:.6g}" if fac["name"] in table[r] else "" for r in resp for v in table[r].get(fac["name"], (0, 0))])
     os.replace(os.path.join(folder, "hsic.csv.tmp"), os.path.join(folder, "hsic.csv"))
     surrogates = []
     for r in [x for x in resp if x.startswith("ratio_") or x == PLATEAU]:
         names = [n for n, _ in sorted(table[r].items(), key=lambda kv: -kv[1][0])[:top]]
-        surrogates.append(kriging_surrogate(study, rows, r, names, scatter.get(r)))
-    chaos = [chaos_or_none(study, rows, r) for r in resp if r.startswith("ratio_")]
+        surrogates.append(kriging_surrogate(*views[r], r, names, scatter.get(r)))
+    chaos = [chaos_or_none(*views[r], r) for r in resp if r.startswith("ratio_")]
     chaos = [c for c in chaos if c]
     joint_factors = []
     for s_ in surrogates:
@@ -187,6 +189,9 @@ def analyze(study, out, permutations=2000, top=3, root=None):
     for fac in study["factors"]:
         cells = []
         for r in resp:
+            if fac["name"] not in table[r]:
+                cells.append("- (cannot act)")
+                continue
             r2, p = table[r][fac["name"]]
             cell = f"{r2:.3f} ({p:.3f})"
             cells.append((f"**{cell}**" if p < 0.05 else cell) + (" †" if p < bonferroni else ""))
@@ -247,7 +252,7 @@ def analyze(study, out, permutations=2000, top=3, root=None):
     with open(os.path.join(folder, "hsic.md"), "w") as f:
         f.write("\n".join(md))
     plot_hsic(os.path.join(folder, "hsic.png"), study, table, resp)
-    plot_scatter(os.path.join(folder, "ratio_scatter.png"), study, rows, table)
+    plot_scatter(os.path.join(folder, "ratio_scatter.png"), study, views, table)
     print("\n".join(md))
     return result
 

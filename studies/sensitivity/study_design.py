@@ -33,6 +33,8 @@ def read_study(path):
             raise StudyError(f"{path}: factor '{f['name']}': 'range' must be [lo, hi] with lo < hi")
         if "levels" in f and len(f["levels"]) < 2:
             raise StudyError(f"{path}: factor '{f['name']}': give at least two levels")
+        if f.get("acts_within_lip") and "range" not in f:
+            raise StudyError(f"{path}: factor '{f['name']}': 'acts_within_lip' needs a 'range' (a depth in mm)")
     if not (isinstance(study["batch_points"], int) and study["batch_points"] >= 2):
         raise StudyError(f"{path}: 'batch_points' must be an integer of at least 2")
     factor_keys = {f["key"] for f in study["factors"]}

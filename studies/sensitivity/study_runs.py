@@ -47,6 +47,7 @@ def read_points(study, out):
                     with open(summary) as f:
                         s = json.load(f)
                     entry["floor_contact"] = (s.get("groove") or {}).get("floor_contact_fraction")
+                    entry["lip_thickness_mm"] = (s.get("lip_release") or {}).get("lip_thickness_mm", 0.0)  # none: no lip
                 records[point]["runs"][replica][needle] = entry
         batch += 1
     return records
@@ -101,6 +102,12 @@ def complete_rows(study, records):
             for field, column in (("groove_fill", "groove_fill"), ("floor_contact", "floor_contact"), ("runtime_s", "runtime")):
                 suffix = "_s" if field == "runtime_s" else ""
                 row[f"{column}_{n}{suffix}"] = mean_of(rec["runs"][name][n][field] for name in complete)
+        if any(f.get("acts_within_lip") for f in study["factors"]):
+            for n in study["needles"]:
+                thickness = [rec["runs"][name][n].get("lip_thickness_mm") for name in complete]
+                if any(t is None for t in thickness):
+                    raise StudyError(f"point {point} {n}: a factor acts within the lip, but the run's summary.json is missing")
+                row[f"lip_thickness_{n}_mm"] = max(thickness)
         errors = calibrated_errors({n: row[f"ratio_{n}"] for n in study["needles"] if n != "SB"})
         for n, e in errors.items():
             row[f"calibrated_error_{n}_mm"] = e
@@ -111,6 +118,45 @@ def complete_rows(study, records):
                     row[f"{r}@{name or 'plain'}"] = per_run[name][r] if name in per_run else None
         rows.append(row)
     return rows, incomplete
+
+
+def response_needles(study, response):
+    """The needles a response is made of: a deflection its needle's, a ratio its needle's and SB's, the plateau LMB's,
+    AMB's and SB's."""
+    if response.startswith("delta_"):
+        return [response.split("_")[1]]
+    if response.startswith("ratio_"):
+        return [response.split("_", 1)[1], "SB"]
+    if response == PLATEAU:
+        return ["LMB", "AMB", "SB"]
+    return list(study["needles"])
+
+
+def response_view(study, rows, response):
+    """The study and its rows as one response sees them: a factor that acts within the lip (a depth below tip point A)
+    acts on a needle only up to that needle's lip thickness; beyond it the whole lip is crushed and the run is the same
+    to the last digit. So for this response the factor is clipped at the thickest lip of the response's needles (each
+    row's own, from its runs' summaries), its range with it; where that leaves under 5 % of its range (SB has no lip,
+    LMB's lip is 0.21 mm), the factor cannot act on the response and is left out. Without such a factor, the study and
+    rows as they are."""
+    clipped = [f for f in study["factors"] if f.get("acts_within_lip")]
+    if not clipped:
+        return study, rows
+    needles = response_needles(study, response)
+    factors, view_rows = [], [dict(r) for r in rows]
+    for f in study["factors"]:
+        if not f.get("acts_within_lip"):
+            factors.append(f)
+            continue
+        lo, hi = f["range"]
+        limits = [max(r[f"lip_thickness_{n}_mm"] for n in needles) for r in rows]
+        top = min(hi, max(limits))
+        if top - lo < 0.05 * (hi - lo):
+            continue
+        factors.append(dict(f, range=[lo, top]))
+        for r, limit in zip(view_rows, limits):
+            r[f["name"]] = max(lo, min(r[f["name"]], limit))
+    return dict(study, factors=factors), view_rows
 
 
 def within_point_scatter(study, rows):

@@ -5,7 +5,7 @@ experiment."""
 import math
 
 from study_design import numeric, unit_coordinate, value_at_unit
-from study_runs import calibrated_errors
+from study_runs import calibrated_errors, response_view
 
 MIN_Q2 = 0.5  # below it a surrogate does not predict left-out points well enough for its extremes to be claimed
 # ... unless the runs themselves scatter: a surrogate that misses a left-out point by no more than this many of the
@@ -190,12 +190,27 @@ def kriging_surrogate(study, rows, response, factor_names, noise_sd=None):
 def joint_search(study, rows, factor_names, scatter=None):
     """The point of the box (the named factors; the others averaged out) whose surrogate ratios, calibrated on SB, come
     nearest the experiment: the largest |error| over the multi-bevel needles is the smallest."""
+    import openturns as ot
     scatter = scatter or {}
     needles = [n for n in study["needles"] if n != "SB"]
-    fits = {n: fit_kriging(study, rows, f"ratio_{n}", factor_names, scatter.get(f"ratio_{n}")) for n in needles}
-    factors = fits[needles[0]][1]
+    factors = [f for f in study["factors"] if f["name"] in factor_names]
     grid = box_grid(factors, 8192)
-    values = {n: fits[n][0](grid) for n in needles}
+    fits, values = {}, {}
+    for n in needles:
+        # Each ratio's kriging sees the study as that ratio does (a factor within the lip clipped at the needle's lip, or
+        # left out): the box's points are mapped to its own coordinates.
+        view_study, view_rows = response_view(study, rows, f"ratio_{n}")
+        own = [f for f in view_study["factors"] if f["name"] in factor_names]
+        fits[n] = fit_kriging(view_study, view_rows, f"ratio_{n}", [f["name"] for f in own], scatter.get(f"ratio_{n}"))
+        columns = [[factors.index(next(g for g in factors if g["name"] == f["name"])), f] for f in own]
+        mapped = ot.Sample(grid.getSize(), len(own))
+        for i in range(grid.getSize()):
+            for k, (j, f) in enumerate(columns):
+                value = value_at_unit(factors[j], float(grid[i, j]))
+                if "range" in f:
+                    value = min(max(value, f["range"][0]), f["range"][1])
+                mapped[i, k] = unit_coordinate(f, value)
+        values[n] = fits[n][0](mapped)
     best, best_score = 0, float("inf")
     for i in range(grid.getSize()):
         score = max(abs(e) for e in calibrated_errors({n: values[n][i][0] for n in needles}).values())

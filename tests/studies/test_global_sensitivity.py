@@ -240,6 +240,62 @@ with tempfile.TemporaryDirectory() as tmp:
     with open(os.path.join(tmp, "analysis", "hsic.md")) as f:
         check("share of the runs' variance within points" in f.read(), "the analysis's tables show the scatter within points")
 
+# A factor that acts within the lip (a depth below tip point A): on a needle it acts only up to that needle's lip
+# thickness (the runs' summary.json), beyond it the run is the same. AMB's ratio (lip 0.43 mm) sees the depth clipped at
+# 0.43; LMB's (lip 0.21, the range starting at 0.2) and SB's cannot see it at all. With the clip the kriging follows
+# the hinge and the joint search finds the function's own minimax.
+lip_study = {"needles": ["SB", "LMB", "AMB"], "batch_points": 32,
+             "factors": [{"name": "groove_start_mm", "key": "needle.groove_start_mm", "range": [3.0, 6.0]},
+                         {"name": "crushed_depth_mm", "key": "tissue.contact.lip_release_depth_mm", "range": [0.2, 0.8], "acts_within_lip": True}]}
+LIPS = {"SB": None, "LMB": 0.21, "AMB": 0.43}
+
+
+def lip_truth(values):
+    g = (values["needle.groove_start_mm"] - 3.0) / 3.0
+    d = min(values["tissue.contact.lip_release_depth_mm"], 0.43)
+    return {"LMB": -0.5 + 0.6 * g, "AMB": -0.4 + 0.3 * g + 1.5 * (0.43 - d)}
+
+
+with tempfile.TemporaryDirectory() as tmp:
+    gs.write_batch(lip_study, tmp, 0)
+    for index, (point, needle_name, values) in enumerate(gs.batch_cases(lip_study, 0)):
+        case_dir = os.path.join(tmp, "batch_0", "sweep", "cases", f"case_{index:04d}")
+        os.makedirs(os.path.join(case_dir, "run"))
+        ratio = lip_truth(values)
+        deflection = -1.14 if needle_name == "SB" else -1.14 * ratio[needle_name]
+        with open(os.path.join(case_dir, "case.json"), "w") as f:
+            json.dump({"label": f"point {point:03d} {needle_name}", "status": "finished", "deflection_mm": deflection,
+                       "groove_fill": 0.9, "runtime_s": 1.0}, f)
+        summary = {"groove": {"floor_contact_fraction": 0.1}}
+        if LIPS[needle_name] is not None:
+            summary["lip_release"] = {"lip_thickness_mm": LIPS[needle_name]}
+        with open(os.path.join(case_dir, "run", "summary.json"), "w") as f:
+            json.dump(summary, f)
+    rows, _ = gs.complete_rows(lip_study, gs.read_points(lip_study, tmp))
+    amb_study, amb_rows = gs.response_view(lip_study, rows, "ratio_AMB")
+    depth = next(f for f in amb_study["factors"] if f["name"] == "crushed_depth_mm")
+    check(depth["range"] == [0.2, 0.43] and all(r["crushed_depth_mm"] == min(o["crushed_depth_mm"], 0.43) for r, o in zip(amb_rows, rows)),
+          f"AMB's ratio sees the depth clipped at its lip's 0.43 mm (range {depth['range']})")
+    lmb_study, _ = gs.response_view(lip_study, rows, "ratio_LMB")
+    sb_study, _ = gs.response_view(lip_study, rows, "delta_SB_mm")
+    check([f["name"] for f in lmb_study["factors"]] == ["groove_start_mm"] and [f["name"] for f in sb_study["factors"]] == ["groove_start_mm"],
+          "LMB's ratio (lip 0.21 mm, the range from 0.2) and SB's deflection (no lip) cannot see the depth: it is left out")
+    plateau_study, _ = gs.response_view(lip_study, rows, gs.PLATEAU)
+    check(next(f for f in plateau_study["factors"] if f["name"] == "crushed_depth_mm")["range"] == [0.2, 0.43],
+          "the plateau sees the depth up to its thickest lip, AMB's")
+    amb = gs.kriging_surrogate(amb_study, amb_rows, "ratio_AMB", ["groove_start_mm", "crushed_depth_mm"])
+    check(amb["leave_one_out_q2"] > 0.9 and abs(amb["box_max"]["value"] - (-0.1 + 1.5 * 0.23)) < 0.03,
+          f"the clipped kriging follows the hinge (Q2 {amb['leave_one_out_q2']:.3f}, box max {amb['box_max']['value']:+.3f} against {-0.1 + 1.5 * 0.23:+.3f})")
+    best = min(max(abs(-1.14 * v - gs.MEASURED_MM[k]) for k, v in lip_truth({"needle.groove_start_mm": 3.0 + 3.0 * i / 200,
+                                                                              "tissue.contact.lip_release_depth_mm": 0.2 + 0.6 * j / 200}).items())
+               for i in range(201) for j in range(201))
+    joint = gs.joint_search(lip_study, rows, ["groove_start_mm", "crushed_depth_mm"])
+    check(abs(joint["best_max_error_mm"] - best) < 0.03,
+          f"the joint search over the clipped depth finds the function's smallest largest error ({joint['best_max_error_mm']:.3f} against {best:.3f} mm)")
+    result = gs.analyze(lip_study, tmp, permutations=200)
+    check(result["hsic"]["ratio_AMB"]["crushed_depth_mm"]["p_value"] < 0.01 and "crushed_depth_mm" not in result["hsic"]["ratio_LMB"],
+          "the analysis screens the depth on AMB's ratio and leaves it out of LMB's")
+
 # One more parameter fitted honestly (second_parameter.py): ratios linear in the value, so every fit has a closed form.
 import second_parameter as sp  # noqa: E402
 
