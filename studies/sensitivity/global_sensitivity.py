@@ -169,7 +169,8 @@ def analyze(study, out, permutations=2000, top=3, root=None):
     joint_factors = []
     for s_ in surrogates:
         joint_factors += [n for n in s_["factors"] if n not in joint_factors]
-    joint = joint_search(study, rows, joint_factors, scatter)
+    own = {s_["response"].split("_", 1)[1]: s_["factors"] for s_ in surrogates if s_["response"].startswith("ratio_")}
+    joint = joint_search(study, rows, joint_factors, scatter, own)
     nearest = min(rows, key=lambda r: r["calibrated_max_error_mm"])
     result = {"points_complete": len(rows), "points_incomplete": [{"point": p, "needles": s} for p, s in incomplete],
               "responses": resp, "hsic": {r: {n: {"r2_hsic": v[0], "p_value": v[1]} for n, v in table[r].items()} for r in resp},
@@ -239,7 +240,7 @@ def analyze(study, out, permutations=2000, top=3, root=None):
     md.append(f"- the run design point nearest the experiment: point {nearest['point']}, largest error {nearest['calibrated_max_error_mm']:.3f} mm ("
               + ", ".join(f"{n} {nearest[f'calibrated_error_{n}_mm']:+.3f}" for n in study["needles"] if n != "SB") + ")")
     md.append(("- " if joint["validated"] else "- NOT VALIDATED (a ratio's surrogate is not validated: its best point is no finding): ")
-              + f"the surrogates' best point over {', '.join(joint['factors'])} (LOO Q2 "
+              + f"the surrogates' best point over {', '.join(joint['factors'])} (each ratio's kriging on its own factors above; LOO Q2 "
               + ", ".join(f"{n} {q:.2f}" for n, q in joint["leave_one_out_q2"].items()) + f"): largest error {joint['best_max_error_mm']:.3f} mm ("
               + ", ".join(f"{n} {e:+.3f}" for n, e in joint["best_calibrated_errors_mm"].items()) + ") at "
               + ", ".join(f"{k} {v:.4g}" if isinstance(v, float) else f"{k} {v}" for k, v in joint["best_at"].items()))

@@ -187,9 +187,11 @@ def kriging_surrogate(study, rows, response, factor_names, noise_sd=None):
             "observed_min": min(r[response] for r in rows), "observed_max": max(r[response] for r in rows)}
 
 
-def joint_search(study, rows, factor_names, scatter=None):
+def joint_search(study, rows, factor_names, scatter=None, own_factors=None):
     """The point of the box (the named factors; the others averaged out) whose surrogate ratios, calibrated on SB, come
-    nearest the experiment: the largest |error| over the multi-bevel needles is the smallest."""
+    nearest the experiment: the largest |error| over the multi-bevel needles is the smallest. With own_factors
+    ({needle: names}), each ratio's kriging takes its own factors (those of its surrogate in the tables, so that the
+    search is made of the surrogates validated there); else every ratio takes all the named factors."""
     import openturns as ot
     scatter = scatter or {}
     needles = [n for n in study["needles"] if n != "SB"]
@@ -200,7 +202,7 @@ def joint_search(study, rows, factor_names, scatter=None):
         # Each ratio's kriging sees the study as that ratio does (a factor within the lip clipped at the needle's lip, or
         # left out): the box's points are mapped to its own coordinates.
         view_study, view_rows = response_view(study, rows, f"ratio_{n}")
-        own = [f for f in view_study["factors"] if f["name"] in factor_names]
+        own = [f for f in view_study["factors"] if f["name"] in (own_factors[n] if own_factors else factor_names)]
         fits[n] = fit_kriging(view_study, view_rows, f"ratio_{n}", [f["name"] for f in own], scatter.get(f"ratio_{n}"))
         columns = [[factors.index(next(g for g in factors if g["name"] == f["name"])), f] for f in own]
         mapped = ot.Sample(grid.getSize(), len(own))
