@@ -204,7 +204,8 @@ def joint_search(study, rows, factor_names, scatter=None, own_factors=None):
         view_study, view_rows = response_view(study, rows, f"ratio_{n}")
         own = [f for f in view_study["factors"] if f["name"] in (own_factors[n] if own_factors else factor_names)]
         fits[n] = fit_kriging(view_study, view_rows, f"ratio_{n}", [f["name"] for f in own], scatter.get(f"ratio_{n}"))
-        columns = [[factors.index(next(g for g in factors if g["name"] == f["name"])), f] for f in own]
+        names = [g["name"] for g in factors]
+        columns = [(names.index(f["name"]), f) for f in own]
         mapped = ot.Sample(grid.getSize(), len(own))
         for i in range(grid.getSize()):
             for k, (j, f) in enumerate(columns):
