@@ -33,8 +33,8 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from study_design import (StudyError, batch_cases, batch_folder, factor_value, numeric, read_study, replica_names,  # noqa: E402,F401
                           replica_set, sweep_file, unit_design, write_batch, write_sweep_file)
-from study_runs import (MEASURED_MM, PLATEAU, POOLED_SD_MM, case_records, complete_rows, read_points, replica_scatter,  # noqa: E402,F401
-                        response_view, responses, within_point_scatter)
+from study_runs import (MEASURED_MM, PLATEAU, POOLED_SD_MM, case_records, complete_rows, point_runs, read_points,  # noqa: E402,F401
+                        replica_scatter, response_view, responses, within_point_scatter)
 from study_surrogates import (MIN_Q2, RMSE_OVER_SCATTER, chaos_or_none, hsic_indices, joint_search,  # noqa: E402,F401
                               kriging_surrogate)
 
@@ -68,10 +68,10 @@ def replica_lines(study, rows, within, report_scatter):
              "| response | one run's SD, within points (dof) | the paper report's replicas' SD | share of the runs' variance within points | largest difference (point) |",
              "|---|---|---|---|---|"]
     for r, (sd, dof) in within.items():
-        singles = [row[f"{r}@{name or 'plain'}"] for row in rows for name in names if row.get(f"{r}@{name or 'plain'}") is not None]
+        runs = [(point_runs(study, row, r), row["point"]) for row in rows]
+        singles = [v for values, _ in runs for v in values]
         total = statistics.variance(singles) if len(singles) >= 2 else float("nan")
-        pairs = [(max(v) - min(v), row["point"]) for row in rows
-                 for v in [[row[f"{r}@{name or 'plain'}"] for name in names if row.get(f"{r}@{name or 'plain'}") is not None]] if len(v) >= 2]
+        pairs = [(max(values) - min(values), point) for values, point in runs if len(values) >= 2]
         widest = max(pairs) if pairs else (float("nan"), "-")
         lines.append(f"| {r} | {sd:.3f} ({dof}) | " + (f"{report_scatter[r]:.3f}" if r in report_scatter else "-")
                      + (f" | {sd * sd / total:.2f}" if total > 0 else " | -") + f" | {widest[0]:.3f} ({widest[1]}) |")

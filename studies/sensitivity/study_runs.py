@@ -76,6 +76,16 @@ def mean_of(values):
     return sum(values) / len(values) if values else None
 
 
+def run_column(response, replica):
+    """The column of one run's response beside a point's mean: "ratio_LMB@y0.1", "ratio_LMB@plain" for the plain run."""
+    return f"{response}@{replica or 'plain'}"
+
+
+def point_runs(study, row, response):
+    """The response of each complete run of a row's point (one value without replicas' columns)."""
+    return [row[run_column(response, name)] for name in replica_names(study) if row.get(run_column(response, name)) is not None]
+
+
 def complete_rows(study, records):
     """One row a point with at least one complete run (every needle finished): its factors and, for each response, the
     mean over its complete runs (the plain one and the replicas'); "runs" counts them, and with replicas each run's
@@ -115,7 +125,7 @@ def complete_rows(study, records):
         if len(names) > 1:
             for name in names:
                 for r in responses(study):
-                    row[f"{r}@{name or 'plain'}"] = per_run[name][r] if name in per_run else None
+                    row[run_column(r, name)] = per_run[name][r] if name in per_run else None
         rows.append(row)
     return rows, incomplete
 
@@ -162,14 +172,13 @@ def response_view(study, rows, response):
 def within_point_scatter(study, rows):
     """{response: (standard deviation, degrees of freedom)}: the scatter between a point's runs (the plain one and its
     replicas), pooled over the points with two runs or more. {} for a study without replicas."""
-    names = replica_names(study)
-    if len(names) < 2:
+    if len(replica_names(study)) < 2:
         return {}
     out = {}
     for r in responses(study):
         squares, dof = 0.0, 0
         for row in rows:
-            values = [row[f"{r}@{name or 'plain'}"] for name in names if row.get(f"{r}@{name or 'plain'}") is not None]
+            values = point_runs(study, row, r)
             if len(values) >= 2:
                 m = sum(values) / len(values)
                 squares += sum((v - m) ** 2 for v in values)

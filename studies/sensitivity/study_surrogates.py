@@ -179,9 +179,10 @@ def kriging_surrogate(study, rows, response, factor_names, noise_sd=None):
 
     k_min = min(range(grid.getSize()), key=lambda i: values[i][0])
     k_max = max(range(grid.getSize()), key=lambda i: values[i][0])
+    noise = data_sd(rows, noise_sd)
     return {"response": response, "factors": [f["name"] for f in factors], "points": len(rows),
-            "leave_one_out_q2": q2, "leave_one_out_rmse": rmse, "replica_sd": noise_sd, "data_sd": data_sd(rows, noise_sd),
-            "validated": surrogate_validated(q2, rmse, data_sd(rows, noise_sd)),
+            "leave_one_out_q2": q2, "leave_one_out_rmse": rmse, "replica_sd": noise_sd, "data_sd": noise,
+            "validated": surrogate_validated(q2, rmse, noise),
             "box_min": {"value": values[k_min][0], "at": at(k_min)},
             "box_max": {"value": values[k_max][0], "at": at(k_max)},
             "observed_min": min(r[response] for r in rows), "observed_max": max(r[response] for r in rows)}
