@@ -23,6 +23,9 @@ constexpr double kCertificateSafetyMm = 1e-9;
 constexpr double kParticleRateMm = 1e-4;
 constexpr double kPlaneSafetyMm = 1e-6;  // a segment this near a triangle's plane gets no certificate from it
 
+// How many steps the gaps last when each axis closes at its speed: until the first one closes.
+double steps_lasting(const Eigen::Vector3d& gap, const Eigen::Vector3d& speed) { return gap.cwiseQuotient(speed).minCoeff(); }
+
 // See passes_through_or_certify: whether the segment a-b lies on one side of the triangle's plane by more than
 // kPlaneSafetyMm, and if so the gaps lowered so that their motion along its normal stays below that distance.
 template <class Triangle>
@@ -40,13 +43,13 @@ bool certify_by_plane(const Triangle& t, const Eigen::Vector3d& a, const Eigen::
   const double along = weight.dot(gap);
   if (along <= room) return true;
   Eigen::Vector3d best = gap * (room / along);
-  double best_steps = best.cwiseQuotient(speed).minCoeff();
+  double best_steps = steps_lasting(best, speed);
   for (int axis = 0; axis < 3; ++axis) {
     if (!(weight[axis] > 0)) continue;
     Eigen::Vector3d lowered = gap;
     lowered[axis] = (room - (along - weight[axis] * gap[axis])) / weight[axis];
     if (!(lowered[axis] > 0)) continue;
-    const double steps = lowered.cwiseQuotient(speed).minCoeff();
+    const double steps = steps_lasting(lowered, speed);
     if (steps > best_steps) {
       best_steps = steps;
       best = lowered;
@@ -109,7 +112,7 @@ bool NeedleBondCut::passes_through_or_certify(const Grid& grid, const Eigen::Vec
         if (!(apart[axis] > 0)) continue;
         Eigen::Vector3d lowered = gap;
         lowered[axis] = apart[axis];
-        const double steps = lowered.cwiseQuotient(speed).minCoeff();
+        const double steps = steps_lasting(lowered, speed);
         if (steps > best_steps) {
           best_steps = steps;
           best = axis;
