@@ -14,6 +14,11 @@ surrogates are validated against.
 
     /usr/bin/python3 studies/sensitivity/global_sensitivity.py --out study --batches 2 --jobs 2   # design, run, analyse
     /usr/bin/python3 studies/sensitivity/global_sensitivity.py --out study --analyze-only         # the tables again
+    /usr/bin/python3 studies/sensitivity/global_sensitivity.py --out study --batches 2 --points 8  # batch 1's first 8 points
+
+A study file's "kriging_trend" ("constant", the default, or "linear") is the surrogates' trend; its "held_out":
+{"from_batch": K} adds the held-out check (study_held_out.py): the procedure fitted on batches 0..K-1 predicts the
+points of batch K on, from the design, before they run (analysis/held_out.csv), and is judged on them as they complete.
 
 Writes into --out: batch_K/sweep.json (the sweep file of batch K) and batch_K/sweep/ (its sweep folder), the same in
 batch_K_NAME/ for each replica NAME, and
@@ -35,6 +40,7 @@ from study_design import (StudyError, batch_cases, batch_folder, factor_value, n
                           replica_set, sweep_file, unit_design, write_batch, write_sweep_file)
 from study_runs import (MEASURED_MM, PLATEAU, POOLED_SD_MM, case_records, complete_rows, point_runs, read_points,  # noqa: E402,F401
                         replica_scatter, response_view, responses, within_point_scatter)
+from study_held_out import held_out_check, write_held_out  # noqa: E402
 from study_surrogates import (MIN_Q2, RMSE_OVER_SCATTER, chaos_or_none, hsic_indices, joint_search,  # noqa: E402,F401
                               kriging_surrogate)
 
@@ -161,7 +167,7 @@ def analyze(study, out, permutations=2000, top=3, root=None):
             w.writerow([fac["name"]] + [f"{v:.6g}" if fac["name"] in table[r] else "" for r in resp for v in table[r].get(fac["name"], (0, 0))])
     os.replace(os.path.join(folder, "hsic.csv.tmp"), os.path.join(folder, "hsic.csv"))
     surrogates = []
-    for r in [x for x in resp if x.startswith("ratio_") or x == PLATEAU]:
+    for r in [x for x in resp if x.startswith("ratio_") or x == PLATEAU]:  # the ratios and the plateau
         names = [n for n, _ in sorted(table[r].items(), key=lambda kv: -kv[1][0])[:top]]
         surrogates.append(kriging_surrogate(*views[r], r, names, scatter.get(r)))
     chaos = [chaos_or_none(*views[r], r) for r in resp if r.startswith("ratio_")]
@@ -176,6 +182,10 @@ def analyze(study, out, permutations=2000, top=3, root=None):
               "responses": resp, "hsic": {r: {n: {"r2_hsic": v[0], "p_value": v[1]} for n, v in table[r].items()} for r in resp},
               "replica_sd": scatter, "report_replica_sd": report_scatter,
               "within_point_sd": {r: {"sd": v[0], "dof": v[1]} for r, v in within.items()}, "surrogates": surrogates, "chaos": chaos, "joint": joint, "nearest_run_point": nearest, "measured_mm": MEASURED_MM}
+    fitted = [x for x in resp if x.startswith("ratio_") or x == PLATEAU]
+    held = held_out_check(study, records, rows, fitted, scatter, permutations, top) if study.get("held_out") else None
+    if held:
+        result["held_out"] = {k: v for k, v in held.items() if k != "rows"}
     with open(os.path.join(folder, "surrogate.json.tmp"), "w") as f:
         json.dump(result, f, indent=1)
     os.replace(os.path.join(folder, "surrogate.json.tmp"), os.path.join(folder, "surrogate.json"))
@@ -250,6 +260,8 @@ def analyze(study, out, permutations=2000, top=3, root=None):
                   f"{MEASURED_MM['AMB'] - MEASURED_MM['LMB']:+.2f} +- 0.05 mm)")
     md.append(f"- two standard deviations of the experiment: {2 * POOLED_SD_MM:.2f} mm")
     md.append("")
+    if held:
+        md.extend(write_held_out(folder, held, study, fitted))
     with open(os.path.join(folder, "hsic.md"), "w") as f:
         f.write("\n".join(md))
     plot_hsic(os.path.join(folder, "hsic.png"), study, table, resp)
@@ -265,6 +277,8 @@ def main(argv):
     p.add_argument("--study", default=os.path.join(root, "data", "studies", "global_sensitivity.json"), help="the study file")
     p.add_argument("--out", required=True, help="the study folder (created; reruns resume)")
     p.add_argument("--batches", type=int, default=1, help="run batches 0..N-1 of the design (default 1)")
+    p.add_argument("--points", type=int, default=0,
+                   help="run only the first N points of the last batch (a partial batch; a later run with more, or without, extends it)")
     p.add_argument("--jobs", type=int, default=2, help="worker processes of each sweep (default 2)")
     p.add_argument("--threads", type=int, default=0, help="threads a case (default: the cores divided among the jobs)")
     p.add_argument("--mpi", type=int, default=0, help="run each sweep on N MPI workers instead of --jobs")
@@ -277,10 +291,12 @@ def main(argv):
         study = read_study(args.study)
         if args.batches < 1:
             raise StudyError("--batches must be at least 1")
+        if args.points < 0 or args.points > study["batch_points"]:
+            raise StudyError(f"--points must be between 1 and the study's batch_points ({study['batch_points']})")
         if not args.analyze_only:
             for b in range(args.batches):
                 for replica in replica_names(study):
-                    path = write_batch(study, args.out, b, replica)
+                    path = write_batch(study, args.out, b, replica, args.points if args.points and b == args.batches - 1 else None)
                     if not args.design_only:
                         if not os.access(args.needle, os.X_OK):
                             raise StudyError(f"{args.needle}: no needle command (build it: bash scripts/build.sh needle)")

@@ -37,6 +37,11 @@ def read_study(path):
             raise StudyError(f"{path}: factor '{f['name']}': 'acts_within_lip' needs a 'range' (a depth in mm)")
     if not (isinstance(study["batch_points"], int) and study["batch_points"] >= 2):
         raise StudyError(f"{path}: 'batch_points' must be an integer of at least 2")
+    if study.get("kriging_trend", "constant") not in ("constant", "linear"):
+        raise StudyError(f"{path}: 'kriging_trend' must be \"constant\" or \"linear\"")
+    held = study.get("held_out")
+    if held is not None and not (isinstance(held, dict) and isinstance(held.get("from_batch"), int) and held["from_batch"] >= 1):
+        raise StudyError(f"{path}: 'held_out' needs a 'from_batch' of at least 1 (the surrogates are fitted on the batches before it)")
     factor_keys = {f["key"] for f in study["factors"]}
     replica_names = set()
     for r in study.get("replicas", []):
@@ -101,10 +106,13 @@ def value_at_unit(factor, u):
     return factor["levels"][int(round(u * (len(factor["levels"]) - 1)))]
 
 
-def batch_cases(study, batch):
-    """The design points of one batch, each run on every needle: [(point index, needle, {key: value})]."""
+def batch_cases(study, batch, points_limit=None):
+    """The design points of one batch, each run on every needle: [(point index, needle, {key: value})]; with
+    points_limit, only the batch's first points_limit points (a partial batch, which the whole batch later extends)."""
     n = study["batch_points"]
     points = unit_design(len(study["factors"]), (batch + 1) * n)[batch * n:]
+    if points_limit is not None:
+        points = points[:points_limit]
     cases = []
     for k, u in enumerate(points):
         point = batch * n + k
@@ -114,9 +122,9 @@ def batch_cases(study, batch):
     return cases
 
 
-def sweep_file(study, batch, replica=""):
+def sweep_file(study, batch, replica="", points_limit=None):
     cases = []
-    for point, needle, values in batch_cases(study, batch):
+    for point, needle, values in batch_cases(study, batch, points_limit):
         case = {"label": f"point {point:03d} {needle}", "needle.preset": needle}
         case.update(values)
         cases.append(case)
@@ -130,13 +138,31 @@ def sweep_file(study, batch, replica=""):
     return sweep
 
 
+def extends(longer, shorter):
+    """Whether the sweep `longer` is `shorter` with more cases after its own (a partial batch completed)."""
+    a, b = dict(longer), dict(shorter)
+    cases_a, cases_b = a.pop("design")["cases"], b.pop("design")["cases"]
+    return a == b and len(cases_a) >= len(cases_b) and cases_a[:len(cases_b)] == cases_b
+
+
 def write_sweep_file(path, sweep):
-    """Writes a study's sweep file whole, or accepts the same one already there (a rerun); StudyError for another."""
+    """Writes a study's sweep file whole, or accepts the same one already there (a rerun), or replaces a partial batch's
+    by one that extends it (needle sweep then runs only the cases it has not recorded); StudyError for another."""
     text = json.dumps(sweep, indent=1) + "\n"
     if os.path.exists(path):
         with open(path) as f:
-            if f.read() != text:
-                raise StudyError(f"{path} holds another design (the study changed?): give a new --out")
+            old_text = f.read()
+        if old_text == text:
+            return path
+        old = json.loads(old_text)
+        if extends(old, sweep):
+            raise StudyError(f"{path} holds more of this batch than asked ({len(old['design']['cases'])} cases): "
+                             "run it without --points, or with at least as many")
+        if not extends(sweep, old):
+            raise StudyError(f"{path} holds another design (the study changed?): give a new --out")
+        with open(path + ".tmp", "w") as f:
+            f.write(text)
+        os.replace(path + ".tmp", path)
     else:
         with open(path + ".tmp", "w") as f:
             f.write(text)
@@ -148,7 +174,7 @@ def batch_folder(out, batch, replica=""):
     return os.path.join(out, f"batch_{batch}" + (f"_{replica}" if replica else ""))
 
 
-def write_batch(study, out, batch, replica=""):
+def write_batch(study, out, batch, replica="", points_limit=None):
     folder = batch_folder(out, batch, replica)
     os.makedirs(folder, exist_ok=True)
-    return write_sweep_file(os.path.join(folder, "sweep.json"), sweep_file(study, batch, replica))
+    return write_sweep_file(os.path.join(folder, "sweep.json"), sweep_file(study, batch, replica, points_limit))

@@ -49,8 +49,9 @@ def surrogate_validated(q2, rmse, scatter_sd):
 
 
 def fit_kriging(study, rows, response, factor_names, noise_sd=None):
-    """A kriging surrogate of the response on the named factors (constant trend, squared-exponential ARD, each factor
-    scaled to [0, 1] over its range) and its leave-one-out Q2 and RMSE: (model, factors, q2, rmse). With noise_sd (the
+    """A kriging surrogate of the response on the named factors (the study's "kriging_trend": a constant, the default, or
+    linear in the factors; squared-exponential ARD; each factor scaled to [0, 1] over its range) and its leave-one-out Q2
+    and RMSE: (model, factors, q2, rmse, kriging result). With noise_sd (the
     runs' own scatter, one run's), each row is taken as the response plus that noise, divided by the square root of
     the runs it averages: the surrogate smooths rather than interpolates, and its extremes are those of the response,
     not of one run's rounding. Leave-one-out leaves a whole point out, all its runs."""
@@ -62,25 +63,28 @@ def fit_kriging(study, rows, response, factor_names, noise_sd=None):
     dim = len(factors)
     variances = [noise_sd * noise_sd / r.get("runs", 1) for r in rows] if noise_sd else None
 
+    linear = study.get("kriging_trend", "constant") == "linear"
+
     def fit(keep):
-        basis = ot.ConstantBasisFactory(dim).build()
+        basis = (ot.LinearBasisFactory if linear else ot.ConstantBasisFactory)(dim).build()
         algo = ot.KrigingAlgorithm(x[keep], y[keep], ot.SquaredExponential([0.5] * dim, [1.0]), basis)
         algo.setOptimizationBounds(ot.Interval([0.05] * dim, [10.0] * dim))
         if variances:
             algo.setNoise([variances[i] for i in keep])
         algo.run()
-        return algo.getResult().getMetaModel()
+        return algo.getResult()
 
     n = x.getSize()
     errors = []
     for k in range(n):
         keep = [i for i in range(n) if i != k]
-        errors.append(fit(keep)(x[k])[0] - y[k][0])
+        errors.append(fit(keep).getMetaModel()(x[k])[0] - y[k][0])
     mean = y.computeMean()[0]
     variance = sum((y[i][0] - mean) ** 2 for i in range(n)) / n
     press = sum(e * e for e in errors) / n
     q2 = 1.0 - press / variance if variance > 0 else float("nan")
-    return fit(list(range(n))), factors, q2, math.sqrt(press)
+    result = fit(list(range(n)))
+    return result.getMetaModel(), factors, q2, math.sqrt(press), result
 
 
 def pce_sobol(study, rows, response, degree=2):
@@ -170,7 +174,7 @@ def box_grid(factors, size=4096):
 def kriging_surrogate(study, rows, response, factor_names, noise_sd=None):
     """The response's kriging surrogate on the named factors, its leave-one-out Q2, and its lowest and highest value
     over the factors' box (the other factors averaged out)."""
-    model, factors, q2, rmse = fit_kriging(study, rows, response, factor_names, noise_sd)
+    model, factors, q2, rmse, _ = fit_kriging(study, rows, response, factor_names, noise_sd)
     grid = box_grid(factors)
     values = model(grid)
 
@@ -181,6 +185,7 @@ def kriging_surrogate(study, rows, response, factor_names, noise_sd=None):
     k_max = max(range(grid.getSize()), key=lambda i: values[i][0])
     noise = data_sd(rows, noise_sd)
     return {"response": response, "factors": [f["name"] for f in factors], "points": len(rows),
+            "trend": study.get("kriging_trend", "constant"),
             "leave_one_out_q2": q2, "leave_one_out_rmse": rmse, "replica_sd": noise_sd, "data_sd": noise,
             "validated": surrogate_validated(q2, rmse, noise),
             "box_min": {"value": values[k_min][0], "at": at(k_min)},

@@ -296,6 +296,63 @@ with tempfile.TemporaryDirectory() as tmp:
     check(result["hsic"]["ratio_AMB"]["crushed_depth_mm"]["p_value"] < 0.01 and "crushed_depth_mm" not in result["hsic"]["ratio_LMB"],
           "the analysis screens the depth on AMB's ratio and leaves it out of LMB's")
 
+# A partial batch (--points N): its sweep file is the whole batch's first N points; the whole batch later replaces it
+# (needle sweep then runs only the cases it has not recorded), and a shorter one after it is refused.
+with tempfile.TemporaryDirectory() as tmp:
+    part = gs.sweep_file(study, 1, "", 3)
+    whole = gs.sweep_file(study, 1)
+    check(part["design"]["cases"] == whole["design"]["cases"][:3 * len(study["needles"])] and part["set"] == whole["set"],
+          "a partial batch's sweep file is the whole batch's first points")
+    gs.write_batch(study, tmp, 1, "", 3)
+    path = gs.write_batch(study, tmp, 1)
+    with open(path) as f:
+        check(json.load(f) == whole, "the whole batch replaces its partial sweep file")
+    try:
+        gs.write_batch(study, tmp, 1, "", 3)
+        check(False, "a partial batch after the whole one is refused")
+    except gs.StudyError as e:
+        check("--points" in str(e), f"a partial batch after the whole one is refused ({e})")
+
+# The held-out check ("held_out": {"from_batch": 1}): fitted on batch 0 alone, the surrogates predict batch 1's points
+# from the design, before any of them has run; as they run, the observed means are set beside. On the known smooth
+# function the predictions hold (validated, errors within the sd); where batch 1's runs are offset by 0.3 (the model
+# not what batch 0 showed), the check fails. The linear trend (kriging_trend) follows a ratio linear in a factor.
+with tempfile.TemporaryDirectory() as tmp:
+    held = dict(study, batch_points=24, kriging_trend="linear", held_out={"from_batch": 1})
+
+    def write_records(batch, points_limit=None, offset=0.0):
+        gs.write_batch(held, tmp, batch, "", points_limit)
+        for index, (point, needle_name, values) in enumerate(gs.batch_cases(held, batch, points_limit)):
+            case_dir = os.path.join(tmp, f"batch_{batch}", "sweep", "cases", f"case_{index:04d}")
+            os.makedirs(case_dir, exist_ok=True)
+            deflection, _ = truth(values)
+            value = deflection[needle_name] + (offset * deflection["SB"] if needle_name != "SB" else 0.0)  # the ratio + offset
+            with open(os.path.join(case_dir, "case.json"), "w") as f:
+                json.dump({"label": f"point {point:03d} {needle_name}", "status": "finished", "deflection_mm": value,
+                           "groove_fill": 0.9, "runtime_s": 1.0}, f)
+
+    write_records(0)
+    gs.write_batch(held, tmp, 1, "", 8)
+    before = gs.analyze(held, tmp, permutations=200)["held_out"]
+    check(before["fitted_points"] == 24 and len(before["points"]) == 24 and before["responses"]["ratio_AMB"]["observed_points"] == 0,
+          "the held-out points are predicted before they run")
+    with open(os.path.join(tmp, "analysis", "held_out.csv")) as f:
+        predicted_before = [line.split(",")[7:9] for line in f.read().splitlines()[1:]]
+    write_records(1, 8)
+    after = gs.analyze(held, tmp, permutations=200)
+    ok = after["held_out"]["responses"]
+    with open(os.path.join(tmp, "analysis", "held_out.csv")) as f:
+        predicted_after = [line.split(",")[7:9] for line in f.read().splitlines()[1:]]
+    check(predicted_after == predicted_before, "the runs of the held-out points do not move their predictions")
+    check(all(ok[r]["observed_points"] == 8 and ok[r]["validated"] and ok[r]["rmse"] < 0.03 for r in ("ratio_LMB", "ratio_AMB")),
+          "on the known function the held-out predictions hold (RMSE LMB {:.4f}, AMB {:.4f})".format(ok["ratio_LMB"]["rmse"], ok["ratio_AMB"]["rmse"]))
+    check(next(s_ for s_ in after["surrogates"] if s_["response"] == "ratio_LMB")["trend"] == "linear", "the study's trend is the kriging's")
+    write_records(1, 8, offset=0.3)
+    off = gs.analyze(held, tmp, permutations=200)["held_out"]["responses"]
+    check(not off["ratio_AMB"]["validated"] and not off["ratio_LMB"]["validated"] and abs(off["ratio_AMB"]["bias"] - 0.3) < 0.01,
+          f"batch 1's ratios offset by 0.3 from batch 0's: the held-out check fails (AMB's mean error {off['ratio_AMB']['bias']:+.3f}, "
+          f"Q2 LMB {off['ratio_LMB']['q2']:.2f}, AMB {off['ratio_AMB']['q2']:.2f})")
+
 # One more parameter fitted honestly (second_parameter.py): ratios linear in the value, so every fit has a closed form.
 import second_parameter as sp  # noqa: E402
 
@@ -373,6 +430,18 @@ with tempfile.TemporaryDirectory() as tmp:
     r = subprocess.run([sys.executable, script, "--study", bad, "--out", os.path.join(tmp, "o"), "--design-only"], capture_output=True, text=True)
     check(r.returncode == 2 and "tissue.friction" in r.stderr and not os.path.exists(os.path.join(tmp, "o")),
           f"a replica that moves a factor is refused ({r.stderr.strip()})")
+    with open(bad, "w") as f:
+        json.dump({"needles": ["SB"], "factors": [{"name": "a", "key": "tissue.friction", "range": [0.1, 0.3]}], "batch_points": 4,
+                   "kriging_trend": "quadratic"}, f)
+    r = subprocess.run([sys.executable, script, "--study", bad, "--out", os.path.join(tmp, "o"), "--design-only"], capture_output=True, text=True)
+    check(r.returncode == 2 and "kriging_trend" in r.stderr and not os.path.exists(os.path.join(tmp, "o")),
+          f"an unknown kriging trend is refused ({r.stderr.strip()})")
+    with open(bad, "w") as f:
+        json.dump({"needles": ["SB"], "factors": [{"name": "a", "key": "tissue.friction", "range": [0.1, 0.3]}], "batch_points": 4}, f)
+    r = subprocess.run([sys.executable, script, "--study", bad, "--out", os.path.join(tmp, "o"), "--design-only", "--points", "5"],
+                       capture_output=True, text=True)
+    check(r.returncode == 2 and "--points" in r.stderr and not os.path.exists(os.path.join(tmp, "o")),
+          f"--points beyond a batch is refused ({r.stderr.strip()})")
 
 print(f"{len(failures)} failed" if failures else "all passed")
 sys.exit(1 if failures else 0)

@@ -1,0 +1,115 @@
+"""The held-out check of a study's surrogates: a study file's "held_out": {"from_batch": K}.
+
+A surrogate's leave-one-out Q2 is computed on the points its form was chosen on. The held-out check asks the harder
+question: the analysis's own procedure (each response's HSIC screen, its most influential factors, the kriging with the
+runs' noise, the study's trend) is fitted on the points of batches 0..K-1 only, and predicts the points of batches K
+and after, with a standard deviation (the kriging's own, plus the noise of a point's mean). The predictions are written
+from the design alone, so they can be stored before those points are run; as their runs complete, the analysis adds
+the observed means and judges the predictions by the same rule as leave-one-out (Q2 over the held-out points >= MIN_Q2,
+or their RMSE within RMSE_OVER_SCATTER times the noise of the means).
+"""
+import csv
+import math
+import os
+
+from study_runs import response_view
+from study_surrogates import MIN_Q2, RMSE_OVER_SCATTER, data_sd, fit_kriging, hsic_indices, surrogate_validated
+from study_design import unit_coordinate
+
+
+def held_out_points(study, records):
+    """The design points of the held-out batches (those from held_out.from_batch on), whether run or not."""
+    first = study["held_out"]["from_batch"] * study["batch_points"]
+    return sorted(p for p in records if p >= first)
+
+
+def predict(study, fit_rows, response, noise_sd, points_values, permutations, top):
+    """The procedure fitted on fit_rows for one response, and its (mean, sd) at each of points_values ({key: value})."""
+    import openturns as ot
+    view_study, view_rows = response_view(study, fit_rows, response)
+    ranked = sorted(hsic_indices(view_study, view_rows, response, permutations), key=lambda t: -t[1])
+    names = [name for name, _, _ in ranked[:top]]
+    _, factors, q2, rmse, result = fit_kriging(view_study, view_rows, response, names, noise_sd)
+    predictions = []
+    for values in points_values:
+        x = []
+        for f in factors:
+            value = values[f["key"]]
+            if f.get("acts_within_lip"):  # clipped at the lip as the fitted points were (the needle's lip: its geometry)
+                value = min(max(value, f["range"][0]), f["range"][1])
+            x.append(unit_coordinate(f, value))
+        mean = result.getConditionalMean(ot.Point(x))[0]
+        variance = max(0.0, result.getConditionalMarginalVariance(ot.Point(x)))  # the surrogate's own, without the runs' noise
+        predictions.append((mean, variance))
+    return names, q2, rmse, predictions
+
+
+def held_out_check(study, records, rows, responses, scatter, permutations=2000, top=3):
+    """{"fitted_points", "points", "responses": {response: {...}}, "rows": [...]}: each response's predictions at the
+    held-out points, the observed means where a point is complete, and the verdict."""
+    first = study["held_out"]["from_batch"] * study["batch_points"]
+    fit_rows = [r for r in rows if r["point"] < first]
+    observed = {r["point"]: r for r in rows if r["point"] >= first}
+    points = held_out_points(study, records)
+    runs_per_point = 1 + len(study.get("replicas", []))
+    table = [{"point": p, **{f["name"]: records[p]["values"][f["key"]] for f in study["factors"]},
+              "runs": observed[p]["runs"] if p in observed else 0} for p in points]
+    summary = {}
+    for response in responses:
+        noise = scatter.get(response)
+        names, q2, rmse, predictions = predict(study, fit_rows, response, noise, [records[p]["values"] for p in points], permutations, top)
+        errors, within = [], 0
+        for row, p, (mean, variance) in zip(table, points, predictions):
+            runs = observed[p]["runs"] if p in observed else runs_per_point
+            sd = math.sqrt(variance + (noise or 0.0) ** 2 / runs)  # the surrogate's own, and the noise of a mean of `runs`
+            row[f"{response}_predicted"] = mean
+            row[f"{response}_sd"] = sd
+            row[f"{response}_observed"] = observed[p][response] if p in observed else None
+            if p in observed:
+                errors.append(observed[p][response] - mean)
+                within += abs(errors[-1]) <= 2.0 * sd
+        entry = {"factors": names, "fitted_leave_one_out_q2": q2, "fitted_leave_one_out_rmse": rmse, "observed_points": len(errors)}
+        if errors:
+            values = [observed[p][response] for p in points if p in observed]
+            mean_obs = sum(values) / len(values)
+            spread = sum((v - mean_obs) ** 2 for v in values) / len(values)
+            held_rmse = math.sqrt(sum(e * e for e in errors) / len(errors))
+            held_q2 = 1.0 - held_rmse ** 2 / spread if spread > 0 and len(errors) >= 3 else float("nan")
+            bar_noise = data_sd([observed[p] for p in points if p in observed], noise)
+            entry.update({"rmse": held_rmse, "q2": held_q2, "bias": sum(errors) / len(errors), "within_two_sd": within,
+                          "means_noise": bar_noise, "validated": surrogate_validated(held_q2 if held_q2 == held_q2 else -1.0, held_rmse, bar_noise)})
+        summary[response] = entry
+    return {"fitted_points": len(fit_rows), "points": points, "responses": summary, "rows": table}
+
+
+def write_held_out(folder, check, study, responses):
+    """held_out.csv (one row a held-out point: its factors, each response's prediction, sd and observed mean) and the
+    Markdown lines of the check."""
+    columns = ["point"] + [f["name"] for f in study["factors"]] + ["runs"] + [
+        f"{r}_{k}" for r in responses for k in ("predicted", "sd", "observed")]
+    path = os.path.join(folder, "held_out.csv")
+    with open(path + ".tmp", "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(columns)
+        for row in check["rows"]:
+            w.writerow(["" if row.get(c) is None else (f"{row[c]:.6g}" if isinstance(row[c], float) else row[c]) for c in columns])
+    os.replace(path + ".tmp", path)
+    first = study["held_out"]["from_batch"]
+    md = [f"## Held out: the surrogates fitted on batches 0..{first - 1} ({check['fitted_points']} points) predict the "
+          f"{len(check['points'])} points of batch {first} on", "",
+          f"Each response's procedure as above (its {len(next(iter(check['responses'].values()))['factors'])} most influential factors by HSIC, "
+          f"the kriging with a {study.get('kriging_trend', 'constant')} trend and the runs' noise), fitted without the held-out points; "
+          f"validated by the leave-one-out rule (Q2 over the held-out points >= {MIN_Q2}, or their RMSE within {RMSE_OVER_SCATTER} times "
+          "the noise of their means). The predictions come from the design alone (held_out.csv), so they stand before the runs.", "",
+          "| response | factors | fitted LOO Q2 | held-out points run | RMSE | bar | Q2 | mean error | within 2 sd | validated |",
+          "|---|---|---|---|---|---|---|---|---|---|"]
+    for r in responses:
+        e = check["responses"][r]
+        if e["observed_points"]:
+            md.append(f"| {r} | {', '.join(e['factors'])} | {e['fitted_leave_one_out_q2']:.2f} | {e['observed_points']} | {e['rmse']:.3f} | "
+                      + (f"{RMSE_OVER_SCATTER * e['means_noise']:.3f}" if e["means_noise"] else "-") + f" | {e['q2']:.2f} | {e['bias']:+.3f} | {e['within_two_sd']} of {e['observed_points']} | "
+                      + ("yes" if e["validated"] else "no") + " |")
+        else:
+            md.append(f"| {r} | {', '.join(e['factors'])} | {e['fitted_leave_one_out_q2']:.2f} | 0 | - | - | - | - | - | not yet run |")
+    md.append("")
+    return md
