@@ -234,6 +234,26 @@ std::map<int, std::string> check_sweep_cases(const SweepPlan& plan) {
   return infeasible;
 }
 
+bool plan_extends(const json& plan, const json& stored) {
+  const auto is_prefix = [](const json& shorter, const json& longer) {
+    return shorter.is_array() && longer.is_array() && shorter.size() <= longer.size() && std::equal(shorter.begin(), shorter.end(), longer.begin());
+  };
+  if (!plan.is_object() || !stored.is_object() || !plan.contains("cases") || !stored.contains("cases") ||
+      !is_prefix(stored["cases"], plan["cases"]))
+    return false;
+  json rest = plan, stored_rest = stored;
+  rest.erase("cases");
+  stored_rest.erase("cases");
+  // A listed design ({"cases": [...]}) holds the cases again: they too may only grow at the end.
+  const auto listed = [](const json& j) { return j.contains("design") && j["design"].is_object() && j["design"].contains("cases"); };
+  if (listed(rest) && listed(stored_rest)) {
+    if (!is_prefix(stored_rest["design"]["cases"], rest["design"]["cases"])) return false;
+    rest["design"].erase("cases");
+    stored_rest["design"].erase("cases");
+  }
+  return rest == stored_rest;
+}
+
 void claim_study_folder(const fs::path& dir, const std::string& stored_name, const json& plan, bool allow_other_code) {
   const fs::path file = dir / stored_name;
   const fs::path code_file = dir / kStudyCodeFile;
@@ -255,9 +275,11 @@ void claim_study_folder(const fs::path& dir, const std::string& stored_name, con
     NEEDLE_REQUIRE(fs::is_directory(dir), fmt::format("--out {}: exists and is not a folder", dir.string()));
     if (fs::exists(file)) {
       const json stored = read_json_file(file.string(), "study plan");
-      NEEDLE_REQUIRE(stored == plan, fmt::format("--out {}: holds another study (its {} differs from this file's cases); give a new --out",
-                                                 dir.string(), stored_name));
+      const bool extended = stored != plan && plan_extends(plan, stored);
+      NEEDLE_REQUIRE(stored == plan || extended,
+                     fmt::format("--out {}: holds another study (its {} differs from this file's cases); give a new --out", dir.string(), stored_name));
       check_code();
+      if (extended) write_file_atomically(file.string(), [&](const std::string& scratch) { std::ofstream(scratch) << plan.dump(2) << "\n"; });
       return;
     }
     // Empty, or only what another worker of the same study is writing just now (a Slurm array's tasks start together).

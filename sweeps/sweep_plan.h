@@ -41,10 +41,14 @@ std::map<int, std::string> check_sweep_cases(const SweepPlan& plan);
 
 // The file in a study's folder that names the code (core/provenance.h) that began it.
 inline constexpr const char* kStudyCodeFile = "study_code.txt";
+// Whether `plan` is `stored` with more cases after its own, everything else the same: a listed design that grew (a
+// study's partial batch completed). The stored cases keep their names and values, so their records stay done.
+bool plan_extends(const nlohmann::json& plan, const nlohmann::json& stored);
 // The study folder for this plan: created with its plan file (stored_name, e.g. sweep_plan.json), or an existing
-// one whose plan file is the same study (cases may be done already) and whose cases this code began (its
-// kStudyCodeFile; a folder from before has none and takes this code's). InputError otherwise, nothing changed:
-// another study, or another code unless allow_other_code (--allow-other-code).
+// one whose plan file is the same study, or one this plan extends (plan_extends; the plan file is then rewritten),
+// (cases may be done already) and whose cases this code began (its kStudyCodeFile; a folder from before has none and
+// takes this code's). InputError otherwise, nothing changed: another study, or another code unless allow_other_code
+// (--allow-other-code).
 void claim_study_folder(const std::filesystem::path& dir, const std::string& stored_name, const nlohmann::json& plan,
                         bool allow_other_code = false);
 

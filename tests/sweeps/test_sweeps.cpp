@@ -234,7 +234,7 @@ TEST_CASE("needle sweep gives one table on worker processes, on MPI ranks and as
   CHECK(read_json(dir / "array" / "sweep.json")["counts"]["stopped"] == 1);
 }
 
-TEST_CASE("A sweep interrupted midway loses no finished case and repeats none when started again", "[sweeps][gmsh][lspg][slow]") {
+TEST_CASE("A sweep interrupted midway, or whose listed design grows, loses no finished case and repeats none when started again", "[sweeps][gmsh][lspg][slow]") {
   const fs::path dir = fresh_folder("sweep_resume");
   write_tiny_scene(dir);
   write(dir / "sweep.json", R"({"base": {"scene": "scene.json"}, "model": "fast", "variables": {"tissue.friction": {"from": 0.05, "to": 0.4, "count": 8}}})");
@@ -307,6 +307,30 @@ TEST_CASE("A sweep interrupted midway loses no finished case and repeats none wh
   const Result other = run("sweep " + (dir / "other.json").string() + " --out " + out.string(), true);
   CHECK(other.exit_code == 2);
   CHECK(other.out.find("holds another study") != std::string::npos);
+  // A listed design that grows at its end (a study's partial batch completed) goes on in the same folder: the cases
+  // done keep their records, only the new ones run. One that drops or changes a case is another study.
+  const fs::path listed = dir / "listed";
+  write(dir / "two.json", R"({"base": {"scene": "scene.json"}, "model": "fast", "design": {"cases": [{"tissue.friction": 0.1}, {"tissue.friction": 0.2}]}})");
+  write(dir / "three.json", R"({"base": {"scene": "scene.json"}, "model": "fast", "design": {"cases": [{"tissue.friction": 0.1}, {"tissue.friction": 0.2}, {"tissue.friction": 0.3}]}})");
+  write(dir / "changed.json", R"({"base": {"scene": "scene.json"}, "model": "fast", "design": {"cases": [{"tissue.friction": 0.1}, {"tissue.friction": 0.25}, {"tissue.friction": 0.3}]}})");
+  const Result two = run("sweep " + (dir / "two.json").string() + " --out " + listed.string(), true);
+  INFO(two.out);
+  REQUIRE(two.exit_code == 0);
+  const auto first_record_time = fs::last_write_time(listed / "cases" / "case_0000" / "case.json");
+  const Result three = run("sweep " + (dir / "three.json").string() + " --out " + listed.string(), true);
+  INFO(three.out);
+  REQUIRE(three.exit_code == 0);
+  CHECK(three.out.find("2 of 3 cases done before") != std::string::npos);
+  CHECK(fs::last_write_time(listed / "cases" / "case_0000" / "case.json") == first_record_time);
+  CHECK(read_json(listed / "sweep.json")["counts"]["finished"] == 3);
+  CHECK(read_json(listed / "sweep_plan.json")["cases"].size() == 3);
+  for (const char* file : {"two.json", "changed.json"}) {
+    const Result refused = run("sweep " + (dir / file).string() + " --out " + listed.string(), true);
+    INFO(refused.out);
+    CHECK(refused.exit_code == 2);
+    CHECK(refused.out.find("holds another study") != std::string::npos);
+  }
+  CHECK(read_json(listed / "sweep_plan.json")["cases"].size() == 3);
 }
 
 TEST_CASE("needle sweep --mpi interrupted exits 130 and leaves no rank running, killed it leaves no job, and its rerun goes on",
