@@ -12,7 +12,7 @@ import csv
 import math
 import os
 
-from study_runs import response_view
+from study_runs import response_view, within_point_scatter
 from study_surrogates import MIN_Q2, RMSE_OVER_SCATTER, data_sd, fit_kriging, hsic_indices, surrogate_validated
 from study_design import unit_coordinate
 
@@ -46,10 +46,15 @@ def predict(study, fit_rows, response, noise_sd, points_values, permutations, to
 
 def held_out_check(study, records, rows, responses, scatter, permutations=2000, top=3):
     """{"fitted_points", "points", "responses": {response: {...}}, "rows": [...]}: each response's predictions at the
-    held-out points, the observed means where a point is complete, and the verdict."""
+    held-out points, the observed means where a point is complete, and the verdict. The noise (the kriging's nugget,
+    the sd of a prediction, the bar) is the fitted points' own where the study has replicas, else `scatter`."""
     first = study["held_out"]["from_batch"] * study["batch_points"]
     fit_rows = [r for r in rows if r["point"] < first]
     observed = {r["point"]: r for r in rows if r["point"] >= first}
+    # The runs' noise as the fitted points alone measure it (their replicas), so that nothing of the held-out points
+    # enters the predictions; without replicas, the analysis's (the paper report's).
+    within = within_point_scatter(study, fit_rows)
+    scatter = {r: v[0] for r, v in within.items()} if within else scatter
     points = held_out_points(study, records)
     runs_per_point = 1 + len(study.get("replicas", []))
     table = [{"point": p, **{f["name"]: records[p]["values"][f["key"]] for f in study["factors"]},
