@@ -42,7 +42,7 @@ from study_runs import (MEASURED_MM, PLATEAU, POOLED_SD_MM, case_records, comple
                         replica_scatter, response_view, responses, within_point_scatter)
 from study_held_out import held_out_check, write_held_out  # noqa: E402
 from study_surrogates import (MIN_Q2, RMSE_OVER_SCATTER, chaos_or_none, hsic_indices, joint_search,  # noqa: E402,F401
-                              kriging_surrogate)
+                              kriging_surrogate, run_distances)
 
 
 def run_batch(args, sweep_path):
@@ -62,6 +62,16 @@ def run_batch(args, sweep_path):
         print(f"global_sensitivity: some cases of {sweep_path} did not finish; their points are left out", flush=True)
     elif status != 0:
         raise StudyError(f"needle sweep exited {status} for {sweep_path}")
+
+
+def reach_words(surrogate):
+    """" (extrapolated: ...)" where a box extreme lies farther from every run point than the runs lie from each other
+    (run_distances): its value is the surrogate's trend, not something the runs have seen."""
+    far = [(k, surrogate[k]) for k in ("box_min", "box_max") if surrogate[k].get("extrapolated")]
+    if not far:
+        return ""
+    return (" (extrapolated: " + ", ".join(f"{k[4:]} {d['nearest_run']:.2f} from the nearest run" for k, d in far)
+            + f", the runs {far[0][1]['run_spacing']:.2f} apart)")
 
 
 def replica_lines(study, rows, within, report_scatter):
@@ -229,7 +239,7 @@ def analyze(study, out, permutations=2000, top=3, root=None):
                   + (f"{s['replica_sd']:.3f} | {s['data_sd']:.3f}" if s["replica_sd"] else "- | -") + " | "
                   + f"{s['observed_min']:+.3f}..{s['observed_max']:+.3f} | "
                   + (f"{s['box_min']['value']:+.3f}..{s['box_max']['value']:+.3f}" if s["validated"] else
-                     f"({s['box_min']['value']:+.3f}..{s['box_max']['value']:+.3f})")
+                     f"({s['box_min']['value']:+.3f}..{s['box_max']['value']:+.3f})") + reach_words(s)
                   + f" | {experiment:+.3f} |")
     md.append("")
     if within:
@@ -241,7 +251,7 @@ def analyze(study, out, permutations=2000, top=3, root=None):
         big = sorted(((n, v) for n, v in c["sobol"].items() if v[1] >= 0.05), key=lambda kv: -kv[1][1])
         md.append(f"- {c['response']} (degree {c['degree']}, Q2 {c['leave_one_out_q2']:.2f}, {c['terms']} terms): "
                   + (", ".join(f"{n} {v[0]:.2f} / {v[1]:.2f}" for n, v in big) if big else "no factor reaches 0.05")
-                  + (f"; over the whole box {c['box_min']['value']:+.3f}..{c['box_max']['value']:+.3f} (lowest at "
+                  + (f"; over the whole box {c['box_min']['value']:+.3f}..{c['box_max']['value']:+.3f}{reach_words(c)} (lowest at "
                      + ", ".join(f"{k} {v:.4g}" if isinstance(v, float) else f"{k} {v}" for k, v in c["box_min"]["at"].items()) + ")"
                      if c["validated"] else ""))
     md.append("")
@@ -253,7 +263,9 @@ def analyze(study, out, permutations=2000, top=3, root=None):
               + f"the surrogates' best point over {', '.join(joint['factors'])} (each ratio's kriging on its own factors above; LOO Q2 "
               + ", ".join(f"{n} {q:.2f}" for n, q in joint["leave_one_out_q2"].items()) + f"): largest error {joint['best_max_error_mm']:.3f} mm ("
               + ", ".join(f"{n} {e:+.3f}" for n, e in joint["best_calibrated_errors_mm"].items()) + ") at "
-              + ", ".join(f"{k} {v:.4g}" if isinstance(v, float) else f"{k} {v}" for k, v in joint["best_at"].items()))
+              + ", ".join(f"{k} {v:.4g}" if isinstance(v, float) else f"{k} {v}" for k, v in joint["best_at"].items())
+              + (f"; EXTRAPOLATED: {joint['best_distance']['nearest_run']:.2f} from the nearest run point, the runs "
+                 f"{joint['best_distance']['run_spacing']:.2f} apart (unit box)" if joint["best_distance"]["extrapolated"] else ""))
     if PLATEAU in resp:
         values = [r[PLATEAU] for r in rows]
         md.append(f"- AMB - LMB with SB calibrated, over the run points: {min(values):+.3f} to {max(values):+.3f} mm (the experiment: "

@@ -3,6 +3,7 @@ indices with permutation p-values, kriging surrogates that take the runs' noise 
 additive polynomial chaos with its Sobol' indices, and the joint search of the box for the point nearest the
 experiment."""
 import math
+import statistics
 
 from study_design import numeric, unit_coordinate, value_at_unit
 from study_runs import calibrated_errors, response_view
@@ -40,6 +41,22 @@ def data_sd(rows, noise_sd):
     if not noise_sd:
         return None
     return noise_sd * math.sqrt(sum(1.0 / r.get("runs", 1) for r in rows) / len(rows))
+
+
+def run_distances(factors, rows, unit_point):
+    """How far a point of the box (unit coordinates over `factors`) lies from the nearest run point, and how far the run
+    points lie from each other (the median of each one's nearest neighbour), both in unit coordinates: a surrogate's
+    value at a point farther from every run than the runs are from each other is an extrapolation, whatever its
+    validation on the runs says (the validation's points are the runs' own neighbours)."""
+    points = [[unit_coordinate(f, r[f["name"]]) for f in factors] for r in rows]
+
+    def distance(a, b):
+        return math.sqrt(sum((x - y) ** 2 for x, y in zip(a, b)))
+
+    nearest = min(distance(unit_point, p) for p in points)
+    spacing = statistics.median(min(distance(p, q) for j, q in enumerate(points) if j != i) for i, p in enumerate(points)) \
+        if len(points) >= 2 else float("nan")
+    return {"nearest_run": nearest, "run_spacing": spacing, "extrapolated": nearest > spacing}
 
 
 def surrogate_validated(q2, rmse, scatter_sd):
@@ -145,7 +162,9 @@ def pce_sobol(study, rows, response, degree=2):
         return {f["name"]: value_at_unit(f, float(grid[k, j])) for j, f in enumerate(factors)}
 
     return {"response": response, "degree": degree, "terms": int(result.getIndices().getSize()), "leave_one_out_q2": q2, "sobol": indices,
-            "validated": q2 >= MIN_Q2, "box_min": {"value": values[k_min][0], "at": at(k_min)}, "box_max": {"value": values[k_max][0], "at": at(k_max)}}
+            "validated": q2 >= MIN_Q2,
+            "box_min": {"value": values[k_min][0], "at": at(k_min), **run_distances(factors, rows, list(grid[k_min]))},
+            "box_max": {"value": values[k_max][0], "at": at(k_max), **run_distances(factors, rows, list(grid[k_max]))}}
 
 
 def chaos_or_none(study, rows, response):
@@ -188,8 +207,8 @@ def kriging_surrogate(study, rows, response, factor_names, noise_sd=None):
             "trend": study.get("kriging_trend", "constant"),
             "leave_one_out_q2": q2, "leave_one_out_rmse": rmse, "replica_sd": noise_sd, "data_sd": noise,
             "validated": surrogate_validated(q2, rmse, noise),
-            "box_min": {"value": values[k_min][0], "at": at(k_min)},
-            "box_max": {"value": values[k_max][0], "at": at(k_max)},
+            "box_min": {"value": values[k_min][0], "at": at(k_min), **run_distances(factors, rows, list(grid[k_min]))},
+            "box_max": {"value": values[k_max][0], "at": at(k_max), **run_distances(factors, rows, list(grid[k_max]))},
             "observed_min": min(r[response] for r in rows), "observed_max": max(r[response] for r in rows)}
 
 
@@ -230,4 +249,5 @@ def joint_search(study, rows, factor_names, scatter=None, own_factors=None):
             "leave_one_out_q2": {n: fits[n][2] for n in needles}, "leave_one_out_rmse": {n: fits[n][3] for n in needles},
             "validated": all(surrogate_validated(fits[n][2], fits[n][3], data_sd(rows, scatter.get(f"ratio_{n}"))) for n in needles),
             "best_at": {f["name"]: value_at_unit(f, float(grid[best, j])) for j, f in enumerate(factors)},
-            "best_ratios": ratios, "best_calibrated_errors_mm": calibrated_errors(ratios), "best_max_error_mm": best_score}
+            "best_ratios": ratios, "best_calibrated_errors_mm": calibrated_errors(ratios), "best_max_error_mm": best_score,
+            "best_distance": run_distances(factors, rows, list(grid[best]))}

@@ -8,6 +8,7 @@
   two factors the ratios depend on (p < 0.01) and gives the inert ones a far smaller index, and the kriging surrogate
   of a smooth ratio predicts left-out points (Q2 > 0.9) and reaches the function's own extremes over the box, the
   additive polynomial chaos gives the closed form's Sobol' indices, and the joint search finds the function's minimax.
+- A box point's distance from the nearest run and the runs' spacing (an extrapolation flag) on known layouts.
 - A partial batch (--points) is the whole batch's first points, which the whole batch later extends. The held-out
   check predicts batch 1 from batch 0 before it runs, the runs leave the predictions as they were, the known function's
   predictions hold and an offset of 0.3 in batch 1's ratios fails the check.
@@ -138,6 +139,18 @@ with tempfile.TemporaryDirectory() as tmp:
           f"the joint search finds the function's smallest largest error over the box ({joint['best_max_error_mm']:.3f} against {best:.3f} mm)")
     for name in ("points.csv", "hsic.csv", "hsic.md", "surrogate.json", "hsic.png", "ratio_scatter.png"):
         check(os.path.getsize(os.path.join(tmp, "analysis", name)) > 0, f"analysis/{name} is written")
+
+# How far a box point lies from the runs: the nearest run and the runs' own spacing (the median nearest neighbour), in
+# unit coordinates; a point farther out than the runs' spacing is an extrapolation.
+square = [{"a": x, "b": 2.0 * y} for x in (0.0, 1.0) for y in (0.0, 1.0)]
+unit_factors = [{"name": "a", "range": [0.0, 1.0]}, {"name": "b", "range": [0.0, 2.0]}]
+inside = gs.run_distances(unit_factors, square, [0.5, 0.5])
+check(abs(inside["nearest_run"] - 0.5 ** 0.5) < 1e-12 and abs(inside["run_spacing"] - 1.0) < 1e-12 and not inside["extrapolated"],
+      f"the square's centre lies sqrt(1/2) from its corners, which lie 1 apart: not an extrapolation ({inside})")
+clustered = [{"a": 0.0, "b": 0.0}, {"a": 0.1, "b": 0.0}, {"a": 0.0, "b": 0.2}]
+far = gs.run_distances(unit_factors, clustered, [1.0, 1.0])
+check(abs(far["nearest_run"] - (0.9 ** 2 + 1.0) ** 0.5) < 1e-12 and abs(far["run_spacing"] - 0.1) < 1e-12 and far["extrapolated"],
+      f"a corner far from runs 0.1 apart is an extrapolation ({far})")
 
 # Runs that scatter (a lattice's phase, rounding): the replicas' standard deviation, and a kriging that takes it as noise.
 with tempfile.TemporaryDirectory() as tmp:
