@@ -177,7 +177,8 @@ def analyze(study, out, permutations=2000, top=3, root=None):
             w.writerow([fac["name"]] + [f"{v:.6g}" if fac["name"] in table[r] else "" for r in resp for v in table[r].get(fac["name"], (0, 0))])
     os.replace(os.path.join(folder, "hsic.csv.tmp"), os.path.join(folder, "hsic.csv"))
     surrogates = []
-    for r in [x for x in resp if x.startswith("ratio_") or x == PLATEAU]:  # the ratios and the plateau
+    fitted = [x for x in resp if x.startswith("ratio_") or x == PLATEAU]  # the ratios and the plateau
+    for r in fitted:
         names = [n for n, _ in sorted(table[r].items(), key=lambda kv: -kv[1][0])[:top]]
         surrogates.append(kriging_surrogate(*views[r], r, names, scatter.get(r)))
     chaos = [chaos_or_none(*views[r], r) for r in resp if r.startswith("ratio_")]
@@ -192,7 +193,6 @@ def analyze(study, out, permutations=2000, top=3, root=None):
               "responses": resp, "hsic": {r: {n: {"r2_hsic": v[0], "p_value": v[1]} for n, v in table[r].items()} for r in resp},
               "replica_sd": scatter, "report_replica_sd": report_scatter,
               "within_point_sd": {r: {"sd": v[0], "dof": v[1]} for r, v in within.items()}, "surrogates": surrogates, "chaos": chaos, "joint": joint, "nearest_run_point": nearest, "measured_mm": MEASURED_MM}
-    fitted = [x for x in resp if x.startswith("ratio_") or x == PLATEAU]
     held = held_out_check(study, records, rows, fitted, scatter, permutations, top) if study.get("held_out") else None
     if held:
         result["held_out"] = {k: v for k, v in held.items() if k != "rows"}

@@ -84,7 +84,7 @@ def held_out_check(study, records, rows, responses, scatter, permutations=2000, 
             entry.update({"rmse": held_rmse, "q2": held_q2, "bias": sum(errors) / len(errors), "within_two_sd": within,
                           "means_noise": bar_noise, "validated": surrogate_validated(held_q2 if held_q2 == held_q2 else -1.0, held_rmse, bar_noise)})
         summary[response] = entry
-    return {"fitted_points": len(fit_rows), "points": points, "responses": summary, "rows": table}
+    return {"fitted_points": len(fit_rows), "top": top, "points": points, "responses": summary, "rows": table}
 
 
 def write_held_out(folder, check, study, responses):
@@ -102,7 +102,7 @@ def write_held_out(folder, check, study, responses):
     first = study["held_out"]["from_batch"]
     md = [f"## Held out: the surrogates fitted on batches 0..{first - 1} ({check['fitted_points']} points) predict the "
           f"{len(check['points'])} points of batch {first} on", "",
-          f"Each response's procedure as above (its {len(next(iter(check['responses'].values()))['factors'])} most influential factors by HSIC, "
+          f"Each response's procedure as above (its {check['top']} most influential factors by HSIC, "
           f"the kriging with a {study.get('kriging_trend', 'constant')} trend and the runs' noise), fitted without the held-out points; "
           f"validated by the leave-one-out rule (Q2 over the held-out points >= {MIN_Q2}, or their RMSE within {RMSE_OVER_SCATTER} times "
           "the noise of their means). The predictions come from the design alone (held_out.csv), so they stand before the runs.", "",
