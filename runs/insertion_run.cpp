@@ -174,8 +174,8 @@ class InsertionRunModel : public RunModel {
   void open_outputs(const RunFolder& folder) override { output_ = std::make_unique<InsertionOutput>(folder, *surface_, run_->separations()); }
   void record() override {
     output_->record(*run_, tip_, run_groove_fill(*run_, built_, scene_));
-    // Over the stroke, which particles touched the groove floor (the tissue cut free may lift off it by the stop): the
-    // sample's floor_length_during_stroke_mm, beside I_s at the stop.
+    // Over the stroke, which particles the contact listed on the groove floor (the tissue cut free may lift off it by the
+    // stop): the sample's floor_length_during_stroke_mm, beside the contact's list at the stop.
     if (firing_ && firing_->active(time_ms())) {
       const std::vector<std::uint8_t> now = groove_floor_contacts(*run_);
       if (touched_floor_.empty()) touched_floor_.assign(now.size(), 0);
@@ -190,12 +190,12 @@ class InsertionRunModel : public RunModel {
   void close_outputs(const RunFolder& folder) override {
     output_->finish();
     if (!firing_) return;
-    // The sample as the stroke leaves it (on the floor at the stop, as the issue defines I_s; and on it at any record
-    // during the stroke), and its picture.
+    // The sample as the stroke leaves it (I_s by the floor's nearest layer; beside it, the contact's list of particles on
+    // the floor at the stop and at any record during the stroke), and its picture.
     const std::vector<std::uint8_t> on_floor = groove_floor_contacts(*run_);
     sample_ = run_tissue_sample(*run_, built_, *firing_, on_floor);
     sample_touched_during_stroke_ = run_tissue_sample(*run_, built_, *firing_, touched_floor_.empty() ? on_floor : touched_floor_);
-    SamplePictureInput picture{firing_->reference_points(run_->tissue().particles().position_mm, needle_model_->positions_mm()), on_floor, *sample_,
+    SamplePictureInput picture{firing_->reference_points(run_->tissue().particles().position_mm, needle_model_->positions_mm()), *sample_,
                                *built_.groove, built_.radius_mm, firing_->tube()};
     write_png(draw_sample_picture(picture), folder.path("sample.png").string());
   }
@@ -279,7 +279,8 @@ class InsertionRunModel : public RunModel {
     const TissueSample& touched_during_stroke = *sample_touched_during_stroke_;
     const CannulaStroke& s = firing_->stroke();
     summary["sample"] = {
-        {"I_s_mm", sample.floor_length_mm},
+        {"I_s_mm", sample.I_s_mm},
+        {"I_s_measure", "floor_layer_covered_mm"},
         {"floor_length_mm", sample.floor_length_mm},
         {"floor_covered_mm", sample.floor_covered_mm},
         {"floor_length_during_stroke_mm", touched_during_stroke.floor_length_mm},
@@ -299,10 +300,12 @@ class InsertionRunModel : public RunModel {
                      {"tissue_mass_scaling_dt_ms", run_->tissue_dynamics().mass_scaling() ? run_->tissue_dynamics().mass_scaling()->target_dt_ms() : 0.0},
                      {"wall_pushes", firing_->pushes()}, {"max_push_mm", firing_->max_push_mm()}, {"wall_work_mJ", firing_->work_mJ()}}},
         {"definition", "solver/insertion/tissue_sample.h: the particles inside the cannula's mid-wall radius, between the groove's walls within "
-                       "the stroke, above the groove floor less half a spacing, when the cannula stops, in the needle's reference frame; I_s_mm is "
-                       "the extent along the axis of those touching the groove floor then (floor_length_during_stroke_mm: of those that "
-                       "touched it at any record during the stroke; floor_layer_*: of those whose centre lies within the contact's skin and a "
-                       "quarter spacing of the floor, by geometry); x in the needle's reference frame (tip point A at 0)"}};
+                       "the stroke, above the groove floor less half a spacing, when the cannula stops, in the needle's reference frame; "
+                       "floor_layer_*: of those whose centre lies within the contact's skin and a quarter spacing of the floor, by geometry, "
+                       "their extent along the axis and the length of the axis under them; I_s_mm (the length compared with the paper's) is "
+                       "floor_layer_covered_mm, the length of groove floor the sample rests on; floor_length_mm, floor_covered_mm: the same "
+                       "two for the particles the contact lists as touching the floor when it stops (floor_length_during_stroke_mm: at any "
+                       "record during the stroke), kept beside it; x in the needle's reference frame (tip point A at 0)"}};
   }
   std::string log_steps(double solve_s) const override {
     return fmt::format("{} coupling steps and {} needle steps in {:.2f} s, energy balance error {:.3g}, max penetration {:.3g} mm, {} particles "

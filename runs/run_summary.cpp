@@ -1,5 +1,8 @@
 #include "runs/run_summary.h"
 
+#include <fmt/format.h>
+
+#include "core/input_error.h"
 #include "runs/json_file.h"
 
 namespace needle {
@@ -14,10 +17,22 @@ RunOutcome run_outcome(const nlohmann::json& s) {
   o.max_energy_balance_error = number_or_nan(s, "max_energy_balance_error");
   o.max_penetration_mm = number_or_nan(s, "max_penetration_mm");
   if (s.contains("groove") && s["groove"].is_object()) o.groove_fill = number_or_nan(s["groove"], "groove_fill");
-  if (s.contains("sample") && s["sample"].is_object()) o.sample_I_s_mm = number_or_nan(s["sample"], "I_s_mm");
+  if (s.contains("sample") && s["sample"].is_object()) {
+    o.sample_I_s_mm = sample_I_s_mm(s["sample"]);
+    o.sample_contact_extent_mm = number_or_nan(s["sample"], "floor_length_mm");
+  }
   o.particles_inside = s.value("particles_inside", 0L);
   o.steps = s.value("steps", 0L);
   return o;
+}
+
+double sample_I_s_mm(const nlohmann::json& sample) {
+  if (sample.contains("I_s_measure")) {
+    NEEDLE_REQUIRE(sample["I_s_measure"] == "floor_layer_covered_mm",
+                   fmt::format("summary.json: sample.I_s_measure {} is not one this build reads (floor_layer_covered_mm)", sample["I_s_measure"].dump()));
+    return number_or_nan(sample, "I_s_mm");
+  }
+  return number_or_nan(sample, "floor_layer_covered_mm");
 }
 
 }  // namespace needle

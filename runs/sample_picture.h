@@ -16,7 +16,6 @@ namespace needle {
 
 struct SamplePictureInput {
   std::vector<Eigen::Vector3d> reference_points;  // per particle, in the needle's reference frame
-  std::vector<std::uint8_t> touched_floor;        // per particle: on the groove floor (the sample's I_s counts these)
   TissueSample sample;
   GrooveBox groove;
   double rod_radius_mm = 0.5;

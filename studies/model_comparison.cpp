@@ -36,6 +36,10 @@ ModelResults read_model_results(const ComparedModel& model) {
     r.groove_fill = number_or_nan(v, "groove_fill");
     r.status = v.value("status", std::string("unknown"));
     r.insertion_mm = number_or_nan(v, "insertion_mm");
+    if (v.contains("sample") && v["sample"].is_object()) {
+      r.sample_I_s_mm = number_or_nan(v["sample"], "I_s_mm");
+      r.sample_contact_extent_mm = number_or_nan(v["sample"], "contact_extent_mm");
+    }
     m.needles.push_back(r);
   }
   return m;

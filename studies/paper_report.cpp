@@ -82,9 +82,8 @@ FittedParameter fitted_parameter(const PaperReportInput& in, const fs::path& dir
 struct NeedleRun : NeedleOutcome {
   std::string folder, reason;
   double runtime_s = kNaN, floor_contact_fraction = kNaN, mean_gap_mm = kNaN, max_energy_error = kNaN, max_penetration_mm = kNaN;
-  double sample_I_s_mm = kNaN, sample_length_mm = kNaN, sample_volume_mm3 = kNaN, sample_floor_covered_mm = kNaN;  // a fired cannula's
-  long sample_floor_particles = 0;
-  double sample_floor_layer_length_mm = kNaN, sample_floor_layer_covered_mm = kNaN;
+  double sample_length_mm = kNaN, sample_volume_mm3 = kNaN;  // a fired cannula's (I_s and the contact's extent: NeedleOutcome's)
+  long sample_floor_particles = 0, sample_floor_layer_particles = 0;
   long bonds_broken = 0, bonds_cut_by_needle = 0, particles_inside = 0, steps = 0, particles = 0;
   std::string model_description;  // from the run's scene.json: the particles, the needle's cut, the law and the drive where not the paper's
   bool needle_cuts = false;       // the scene's tissue.contact.cuts_bonds
@@ -118,13 +117,12 @@ NeedleRun read_run(const std::string& out_dir, const std::string& name) {
     r.mean_gap_mm = number_or_nan(s["groove"], "mean_gap_mm");
   }
   if (s.contains("sample") && s["sample"].is_object()) {
-    r.sample_I_s_mm = number_or_nan(s["sample"], "I_s_mm");
+    r.sample_I_s_mm = o.sample_I_s_mm;
+    r.sample_contact_extent_mm = o.sample_contact_extent_mm;
     r.sample_length_mm = number_or_nan(s["sample"], "length_mm");
     r.sample_volume_mm3 = number_or_nan(s["sample"], "volume_mm3");
-    r.sample_floor_covered_mm = number_or_nan(s["sample"], "floor_covered_mm");
     r.sample_floor_particles = s["sample"].value("floor_particles", 0L);
-    r.sample_floor_layer_length_mm = number_or_nan(s["sample"], "floor_layer_length_mm");
-    r.sample_floor_layer_covered_mm = number_or_nan(s["sample"], "floor_layer_covered_mm");
+    r.sample_floor_layer_particles = s["sample"].value("floor_layer_particles", 0L);
   }
   r.particles = s.value("particles", 0L);
   const fs::path scene_path = fs::path(r.folder) / "scene.json";
@@ -136,6 +134,28 @@ NeedleRun read_run(const std::string& out_dir, const std::string& name) {
   r.history = read_csv_table((fs::path(r.folder) / "history.csv").string());
   r.facets = read_csv_table((fs::path(r.folder) / "facet_forces.csv").string());
   return r;
+}
+
+// Each needle's sample for the sampling section, with the paper's measured length.
+std::vector<SampledNeedle> sampled_needles(const std::vector<NeedleRun>& runs, const std::vector<PaperReferenceNeedle>& reference) {
+  std::vector<SampledNeedle> sampled;
+  for (const NeedleRun& r : runs) {
+    const PaperReferenceNeedle* ref = find_reference(reference, r.name);
+    sampled.push_back({r.name, r.sample_I_s_mm, r.sample_floor_layer_particles, r.sample_contact_extent_mm, r.sample_floor_particles,
+                       r.sample_length_mm, r.sample_volume_mm3, r.floor_contact_fraction, ref ? ref->sample_length_mm : kNaN});
+  }
+  return sampled;
+}
+
+// The replicas' samples (their results.json "sample"; none where they did not fire the cannula).
+std::vector<SampledReplica> sampled_replicas(const std::vector<ModelResults>& replicas) {
+  std::vector<SampledReplica> out;
+  for (const ModelResults& m : replicas) {
+    SampledReplica r{m.label, {}};
+    for (const NeedleOutcome& n : m.needles) r.needles.push_back({n.name, n.sample_I_s_mm, 0, n.sample_contact_extent_mm, 0, kNaN, kNaN, kNaN, kNaN});
+    out.push_back(r);
+  }
+  return out;
 }
 
 // The tissue's y force on the tip facets, the groove (floor and walls) and the shaft in the run's last
@@ -322,6 +342,8 @@ void write_paper_report(const PaperReportInput& in) {
   std::vector<ModelResults> replicas;
   for (const ComparedModel& c : in.replicas) replicas.push_back(read_model_results(c));
   const ReplicaScatter scatter = replica_scatter(outcomes, targets, replicas, in.reference);
+  const std::vector<SampledNeedle> sampled = sampled_needles(runs, in.reference);
+  const std::vector<SampledReplica> sampled_reps = sampled_replicas(replicas);
 
   // results.json
   json needles = json::object();
@@ -348,6 +370,14 @@ void write_paper_report(const PaperReportInput& in) {
       n["error_vs_experiment_mm"] = r.deflection_mm - ref->deflection_experiment_mm;
       n["sample_length_mm"] = ref->sample_length_mm;
     }
+    if (std::isfinite(r.sample_I_s_mm))
+      n["sample"] = {{"I_s_mm", r.sample_I_s_mm},
+                     {"I_s_measure", "floor_layer_covered_mm"},
+                     {"contact_extent_mm", r.sample_contact_extent_mm},
+                     {"floor_layer_particles", r.sample_floor_layer_particles},
+                     {"contact_particles", r.sample_floor_particles},
+                     {"length_mm", r.sample_length_mm},
+                     {"volume_mm3", r.sample_volume_mm3}};
     needles[r.name] = n;
   }
   json target_list = json::array();
@@ -375,6 +405,17 @@ void write_paper_report(const PaperReportInput& in) {
     results["fitted_parameter"] = {{"key", fitted.key}, {"name", fitted.name}, {"value", fitted.value}, {"fitted_on", fitted.needle},
                                    {"record", fs::proximate(in.fitted_path).string()}};
   if (const json observations = paper_observations_json(observed); !observations.empty()) results["observations"] = observations;
+  if (std::any_of(sampled.begin(), sampled.end(), [](const SampledNeedle& n) { return std::isfinite(n.I_s_mm); })) {
+    const auto verdict_json = [](const SamplingVerdict& v) {
+      return json{{"ranked", v.ranked}, {"ratios_within", v.ratios_within}, {"worst_ratio_miss", v.worst_ratio_miss}};
+    };
+    json lattices = json::array();
+    for (const SamplingLattice& l : judge_sampling_lattices(sampled, sampled_reps))
+      lattices.push_back({{"label", l.label}, {"I_s", verdict_json(l.I_s)}, {"contact_extent", verdict_json(l.contact_extent)}});
+    results["sampling"] = {{"I_s_measure", "floor_layer_covered_mm: the length of groove floor the enclosed tissue rests on"},
+                           {"ratio_tolerance", SamplingVerdict::kRatioTolerance},
+                           {"lattices", lattices}};
+  }
 
   // The pictures.
   save_png(deflection_plot(runs, in.reference), (dir / "deflection_vs_insertion.png").string());
@@ -493,15 +534,7 @@ void write_paper_report(const PaperReportInput& in) {
                       order);
   }
   md += "\n![groove fill](groove_fill.png)\n\n";
-  {
-    std::vector<SampledNeedle> sampled;
-    for (const NeedleRun& r : runs) {
-      const PaperReferenceNeedle* ref = find_reference(in.reference, r.name);
-      sampled.push_back({r.name, r.sample_I_s_mm, r.sample_length_mm, r.sample_volume_mm3, r.sample_floor_covered_mm, r.sample_floor_particles,
-                         r.sample_floor_layer_length_mm, r.sample_floor_layer_covered_mm, r.floor_contact_fraction, ref ? ref->sample_length_mm : kNaN});
-    }
-    md += sampling_section(sampled, tissue);
-  }
+  md += sampling_section(sampled, tissue, sampled_reps);
   md += "## Forces on the facets, and why a needle bends the way it does\n\n";
   md += "The y force the tissue exerts on each part of the needle at the end of insertion (N, +: pushes it up). The tip's "
         "facets and the groove floor are the paper's levers of the bending moment (M_t and M_b). The shaft is the rod's round "

@@ -33,6 +33,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 struct NeedleOutcome {
   std::string name, status;
   double deflection_mm = kNaN, insertion_mm = kNaN, groove_fill = kNaN;
+  double sample_I_s_mm = kNaN, sample_contact_extent_mm = kNaN;  // a fired cannula's (runs/run_summary.h; NaN: none)
 };
 
 // The paper's targets (issue 7), each with its verdict and the numbers behind it.

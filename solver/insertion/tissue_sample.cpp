@@ -17,6 +17,7 @@ TissueSample measure_tissue_sample(const TissueSampleInput& in) {
   NEEDLE_REQUIRE(in.bore_radius_mm > 0, "tissue sample: the bore's radius must be positive");
   TissueSample out;
   out.captured.assign(n, 0);
+  out.in_floor_layer.assign(n, 0);
   double back = std::numeric_limits<double>::infinity(), front = -back;
   std::vector<std::pair<double, double>> floor_spans, layer_spans;  // each floor particle's interval along x
   for (size_t i = 0; i < n; ++i) {
@@ -33,7 +34,10 @@ TissueSample measure_tissue_sample(const TissueSampleInput& in) {
     back = std::min(back, lo);
     front = std::max(front, hi);
     if (!in.touches_floor.empty() && in.touches_floor[i]) floor_spans.emplace_back(lo, hi);
-    if (in.floor_y_mm && X.y() - *in.floor_y_mm <= in.contact_skin_mm + 0.25 * h) layer_spans.emplace_back(lo, hi);
+    if (in.floor_y_mm && X.y() - *in.floor_y_mm <= in.contact_skin_mm + 0.25 * h) {
+      out.in_floor_layer[i] = 1;
+      layer_spans.emplace_back(lo, hi);
+    }
   }
   if (out.particles > 0) {
     out.back_x_mm = back;
@@ -63,6 +67,7 @@ TissueSample measure_tissue_sample(const TissueSampleInput& in) {
   out.floor_layer_particles = static_cast<std::int64_t>(layer_spans.size());
   extent_and_cover(std::move(floor_spans), out.floor_length_mm, out.floor_covered_mm);
   extent_and_cover(std::move(layer_spans), out.floor_layer_length_mm, out.floor_layer_covered_mm);
+  out.I_s_mm = out.floor_layer_covered_mm;
   return out;
 }
 

@@ -8,14 +8,18 @@
 // not counted; without a groove, every particle in the bore counts). A particle stands for the tissue within half its
 // spacing of its centre along x.
 //   length_mm:       the extent along the axis of all captured tissue (its front edge less its back edge);
-//   floor_length_mm: the extent of the captured tissue touching the groove floor (a contact with a groove_floor
-//                    triangle; the caller says when): the sample length I_s compared with the paper's;
-//   floor_covered_mm: the length of the axis under floor-touching tissue (gaps left out), at most floor_length_mm;
-//   floor_layer_length_mm, floor_layer_covered_mm: the same two for the captured particles of the floor's nearest layer,
-//                    by geometry: the centre within the contact's skin and a quarter of its spacing of the floor (the
-//                    contact holds a resting particle at the skin; the next layer lies a spacing higher). The kinematic
-//                    contact lists a particle as touching only in a step it pushes it back, so a sample resting on the
-//                    floor is counted by a few of its particles at a time; the layer counts all of them;
+//   floor_layer_length_mm, floor_layer_covered_mm: for the captured particles of the floor's nearest layer, by
+//                    geometry (the centre within the contact's skin and a quarter of its spacing of the floor: the
+//                    contact holds a resting particle at the skin; the next layer lies a spacing higher), their extent
+//                    along the axis and the length of the axis under them (gaps left out);
+//   I_s_mm:          the sample length compared with the paper's: floor_layer_covered_mm, the length of groove floor
+//                    the captured tissue rests on. Not the layer's extent: by geometry that is the whole groove in every
+//                    paper needle (docs/notebook/sampling.md), so it cannot tell them apart;
+//   floor_length_mm, floor_covered_mm: the same two as the layer's for the particles the contact lists as touching the
+//                    floor (a contact with a groove_floor triangle; the caller says when). The kinematic contact lists a
+//                    particle only in a step it pushes it back, so a sample resting on the floor is counted by a few of
+//                    its particles at a time: kept beside I_s, not compared (the first reading of I_s was this
+//                    extent; it rests on 4 particles for HMB and moved by 16 mm between lattices);
 //   volume_mm3, mass_g: the captured particles' reference volume and (physical) mass.
 #include <Eigen/Dense>
 #include <cstdint>
@@ -38,9 +42,11 @@ struct TissueSample {
   std::int64_t particles = 0, floor_particles = 0;
   double length_mm = 0, floor_length_mm = 0, floor_covered_mm = 0, volume_mm3 = 0, mass_g = 0;
   double floor_layer_length_mm = 0, floor_layer_covered_mm = 0;
+  double I_s_mm = 0;  // floor_layer_covered_mm: the length compared with the paper's
   std::int64_t floor_layer_particles = 0;
   double back_x_mm = 0, front_x_mm = 0;  // the captured tissue's extent (reference frame; 0 when empty)
   std::vector<std::uint8_t> captured;    // per particle
+  std::vector<std::uint8_t> in_floor_layer;  // per particle: captured, and in the floor's nearest layer (I_s covers these)
 };
 
 TissueSample measure_tissue_sample(const TissueSampleInput& input);

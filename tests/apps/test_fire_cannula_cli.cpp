@@ -71,14 +71,21 @@ TEST_CASE("needle run --fire-cannula takes a sample from the groove after the in
   CHECK(f.summary["deflection_mm"].get<double>() == Approx(p.summary["deflection_mm"].get<double>()).epsilon(1e-6));
   CHECK(f.summary["needle_held"]["from_ms"].get<double>() == Approx(insertion_end_ms));
 
-  // The sample: tissue in the groove's part inside the block (1.2 mm), its floor length within its extent, its mass its
+  // The sample: tissue in the groove's part inside the block (1.2 mm), I_s within its extent, its mass its
   // volume's at the card's density.
   const double length = sample["length_mm"].get<double>(), I_s = sample["I_s_mm"].get<double>();
   CHECK(sample["particles"].get<long>() > 0);
   CHECK(length > 0);
   CHECK(length <= 1.2 + 0.2 + 1e-9);  // the groove's part in the tissue, and a particle's half spacing beyond the entry face
-  CHECK(I_s <= length + 1e-12);
-  CHECK(sample["floor_covered_mm"].get<double>() <= I_s + 1e-12);
+  CHECK(I_s > 0);
+  // I_s is the floor the nearest layer covers: within that layer's extent, within the whole sample's; the contact's list
+  // is kept beside it, its covered length within its extent.
+  CHECK(sample["I_s_measure"] == "floor_layer_covered_mm");
+  CHECK(I_s == sample["floor_layer_covered_mm"].get<double>());
+  CHECK(I_s <= sample["floor_layer_length_mm"].get<double>() + 1e-12);
+  CHECK(sample["floor_layer_length_mm"].get<double>() <= length + 1e-12);
+  CHECK(sample["floor_covered_mm"].get<double>() <= sample["floor_length_mm"].get<double>() + 1e-12);
+  CHECK(sample["floor_length_mm"].get<double>() <= length + 1e-12);
   CHECK(sample["mass_g"].get<double>() == Approx(0.98e-3 * sample["volume_mm3"].get<double>()));
   CHECK(f.summary["cannula_edge"]["bonds_cut"].get<long>() > 0);
 

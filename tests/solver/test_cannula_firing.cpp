@@ -150,6 +150,7 @@ TEST_CASE("A cannula fired through free tissue without a needle cuts out a cylin
   CHECK(sample.volume_mm3 == Approx(closed_form_mm3).epsilon(0.04));
   CHECK(sample.length_mm == Approx(3.0 + 0.2).margin(0.05));  // the particles' half spacings beyond the block's faces
   CHECK(sample.floor_length_mm == 0);  // no groove, no floor
+  CHECK(sample.I_s_mm == 0);
   // Every particle of the wall's band was pushed to a face: none is left inside the wall behind the front.
   for (const Vec3d& x : p.position_mm) {
     const double r = radius(x);
@@ -206,7 +207,7 @@ TEST_CASE("A cannula fired along a hole wider than it takes nothing", "[solver][
   CHECK(sample.length_mm == 0);
 }
 
-TEST_CASE("The sample's lengths: the extent of the captured tissue and of the tissue on the floor, gaps left out of the covered length", "[solver][cannula]") {
+TEST_CASE("The sample's lengths: the extent of the captured tissue, and I_s the floor its nearest layer covers, gaps left out", "[solver][cannula]") {
   // Five particles of 0.2 mm at x = 0, 0.2, 1.0, 1.2, 3.0 (mm), one beyond the bore, one below the floor; the floor
   // (y = -0.07) touched by those at 0.2, 1.0 and 1.2 by the contact's list, and by geometry (centre within the skin
   // 0.02 and a quarter spacing, 0.05, of it: y <= 0) the ones at 0 and 1.0, which sit at y = -0.05.
@@ -232,6 +233,7 @@ TEST_CASE("The sample's lengths: the extent of the captured tissue and of the ti
   CHECK(s.floor_layer_particles == 2);
   CHECK(s.floor_layer_length_mm == Approx(1.1 - (-0.1)));
   CHECK(s.floor_layer_covered_mm == Approx(0.2 + 0.2));
+  CHECK(s.I_s_mm == Approx(0.2 + 0.2));  // I_s: the floor the layer covers, not its extent nor the contact's
 }
 
 TEST_CASE("The needle's axis frame carries a point beside a translated and bent needle back to its place", "[solver][cannula]") {

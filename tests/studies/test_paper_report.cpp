@@ -22,6 +22,8 @@ namespace {
 struct FakeRun {
   double deflection_mm, groove_fill;
   double shaft_fy_N = 0;  // the tissue's y force on the shaft at the end
+  double sample_I_s_mm = std::nan("");  // a fired cannula's I_s (NaN: none fired)
+  bool sample_before_2026_11_29 = false;  // the summary as written before I_s_measure: I_s_mm held the contact's extent
 };
 
 // A run folder as run_insertion writes it, with deflection growing linearly to its end value.
@@ -32,7 +34,15 @@ void write_run(const fs::path& dir, const std::string& name, const FakeRun& r) {
                         {"runtime_s", 600.0}, {"steps", 8000}, {"max_energy_balance_error", 0.001}, {"max_penetration_mm", 0.01},
                         {"particles_inside", 0}, {"bonds_broken", 100}, {"bonds_cut_by_needle", 80}, {"particles", 48843},
                         {"groove", {{"groove_fill", r.groove_fill}, {"floor_contact_fraction", r.groove_fill / 2}, {"mean_gap_mm", 0.1}}}};
-  std::ofstream(folder / "summary.json") << summary.dump(2);
+  json written = summary;
+  if (std::isfinite(r.sample_I_s_mm)) {
+    // The contact's extent is the whole groove here (22 mm), the floor layer's extent too; I_s the layer's covered length.
+    written["sample"] = {{"I_s_mm", r.sample_before_2026_11_29 ? 22.0 : r.sample_I_s_mm}, {"floor_layer_covered_mm", r.sample_I_s_mm},
+                         {"floor_layer_length_mm", 22.0}, {"floor_length_mm", 22.0}, {"length_mm", 22.0}, {"volume_mm3", 0.4 * r.sample_I_s_mm},
+                         {"floor_particles", 7}, {"floor_layer_particles", 100}};
+    if (!r.sample_before_2026_11_29) written["sample"]["I_s_measure"] = "floor_layer_covered_mm";
+  }
+  std::ofstream(folder / "summary.json") << written.dump(2);
   const json scene = {{"tissue", {{"spacing_mm", 0.4}, {"path_refinement", 2}, {"path_half_width_mm", 1.2},
                                   {"separation", {{"needle_cut", true}, {"lip", {{"mode", "crushed"}, {"depth_mm", needle::kSceneCrushedLipDepthMm}}}}}}}};
   std::ofstream(folder / "scene.json") << scene.dump(2);
@@ -543,4 +553,38 @@ TEST_CASE("needle paper without --calibration takes the shipped SB calibration, 
   const json calibration = read_json(fs::path(NEEDLE_SOURCE_DIR) / "data" / "paper" / "calibration_sb.json");
   CHECK(scene["tissue"]["material"]["E_MPa"].get<double>() == calibration["tissue_E_MPa"].get<double>());
   CHECK(read_text(dir / "report.md").find("(the shipped calibration of the model level)") != std::string::npos);
+}
+
+TEST_CASE("needle paper with fired runs: I_s beside the measured lengths, its targets in this report and in every replica that fired",
+          "[apps][paper][cannula][slow]") {
+  // This report: I_s 1.7 times the measured lengths (12.5, 12.9, 9.9, 8.6 mm), so every ratio is the measured one. The
+  // replica (its summaries written before 2026-11-29: I_s_mm the contact's extent, 22 mm everywhere, and the layer's
+  // covered length beside) puts HMB's I_s above AMB's: ranked in this report, not in the replica.
+  const fs::path dir = fresh("sampled_this"), replica = fresh("sampled_replica");
+  const std::map<std::string, double> measured = {{"SB", 12.5}, {"LMB", 12.9}, {"AMB", 9.9}, {"HMB", 8.6}};
+  const std::map<std::string, double> deflection = {{"SB", -1.14}, {"LMB", 0.15}, {"AMB", 0.24}, {"HMB", 1.71}};
+  for (const auto& [name, length] : measured) {
+    write_run(dir, name, {deflection.at(name), 0.9, 0, 1.7 * length});
+    write_run(replica, name, {deflection.at(name), 0.9, 0, name == "HMB" ? 1.7 * 10.5 : 1.7 * length, true});
+  }
+  REQUIRE(run("paper --report-only --no-tips --quiet --tissue-E-MPa 0.05 --out " + replica.string(), true).exit_code == 0);
+  const std::string md = report_only(dir, "--tissue-E-MPa 0.05 --replica \"x + 0.1=" + (replica / "results.json").string() + "\"");
+  CHECK(md.find("## The sample: the cannula fired over the groove") != std::string::npos);
+  CHECK(md.find("| AMB | 16.83 | 0.79 | 9.9 | 0.79 | 100 | 22.00, 1.00 [7] | 22.00 |") != std::string::npos);
+  CHECK(md.find("Ranked by predicted I_s (longest first): LMB > SB > AMB > HMB") != std::string::npos);
+  CHECK(md.find("| SB and LMB above AMB, AMB above HMB | met | 1 of 2 |") != std::string::npos);
+  CHECK(md.find("| each ratio to SB within 0.15 of the measured (1.00, 1.03, 0.79, 0.69) | met (worst miss 0.00) | 1 of 2 |") != std::string::npos);
+  // The replica's row: read from its results.json, its I_s the layer's covered length, not the 22 mm of its I_s_mm.
+  CHECK(md.find("| x + 0.1 | 21.25 | 1.03, 0.79, 0.84 | **not ranked**, **ratios missed** (worst 0.15) |") != std::string::npos);
+
+  const json results = read_json(dir / "results.json");
+  CHECK(results["needles"]["HMB"]["sample"]["I_s_mm"].get<double>() == Approx(1.7 * 8.6));
+  CHECK(results["needles"]["HMB"]["sample"]["contact_extent_mm"].get<double>() == 22.0);
+  REQUIRE(results["sampling"]["lattices"].size() == 2);
+  CHECK(results["sampling"]["lattices"][0]["I_s"]["ranked"] == true);
+  CHECK(results["sampling"]["lattices"][1]["label"] == "x + 0.1");
+  CHECK(results["sampling"]["lattices"][1]["I_s"]["ranked"] == false);
+  CHECK(results["sampling"]["lattices"][1]["contact_extent"]["ratios_within"] == false);
+  const json replica_results = read_json(replica / "results.json");
+  CHECK(replica_results["needles"]["HMB"]["sample"]["I_s_mm"].get<double>() == Approx(1.7 * 10.5));
 }
