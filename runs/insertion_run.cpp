@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <fmt/format.h>
 #include <fstream>
 
@@ -169,11 +170,17 @@ class InsertionRunModel : public RunModel {
       at_insertion_end_ = InsertionEnd{tip_displacement_now(), needle_model_->drive_displacement_mm(), run_groove_fill(*run_, built_, scene_),
                                        strain_probes_json(run_strain_probes(*run_, built_, scene_), needle_model_->drive_displacement_mm().norm(),
                                                           deflection_now())};
+      // A history and facet-force row at the insertion's end, the instant its deflection is read (the run without the
+      // firing ends on one): the report's loads and curves stop there (studies/paper_report.cpp).
+      if (output_) {
+        output_->record(*run_, tip_, at_insertion_end_->groove);
+        insertion_end_row_ms_ = time_ms();
+      }
     }
   }
   void open_outputs(const RunFolder& folder) override { output_ = std::make_unique<InsertionOutput>(folder, *surface_, run_->separations()); }
   void record() override {
-    output_->record(*run_, tip_, run_groove_fill(*run_, built_, scene_));
+    if (time_ms() != insertion_end_row_ms_) output_->record(*run_, tip_, run_groove_fill(*run_, built_, scene_));  // not twice
     // Over the stroke, which particles the contact listed on the groove floor (the tissue cut free may lift off it by the
     // stop): the sample's floor_length_during_stroke_mm, beside the contact's list at the stop.
     if (firing_ && firing_->active(time_ms())) {
@@ -341,6 +348,7 @@ class InsertionRunModel : public RunModel {
     json strain_probes;
   };
   std::optional<InsertionEnd> at_insertion_end_;
+  double insertion_end_row_ms_ = std::nan("");  // the time of the row written at the insertion's end (a fired cannula's run)
   std::vector<std::uint8_t> touched_floor_;  // per particle: touched the groove floor at a record during the stroke
   double insertion_mass_scaling_dt_ms_ = 0;  // the tissue's mass scaling target before a firing retargeted it (0: none did)
   std::optional<TissueSample> sample_, sample_touched_during_stroke_;  // at the run's end (close_outputs)

@@ -78,6 +78,14 @@ FittedParameter fitted_parameter(const PaperReportInput& in, const fs::path& dir
   return {needle, record.value("name", key), key, value, md};
 }
 
+// The table's rows up to time_ms (all of them if it has no time_ms column or the time is not a number).
+void keep_rows_until(CsvTable& table, double time_ms) {
+  if (!std::isfinite(time_ms) || !table.has("time_ms")) return;
+  const size_t t = table.index("time_ms");
+  table.rows.erase(std::remove_if(table.rows.begin(), table.rows.end(), [&](const std::vector<double>& row) { return !(row[t] <= time_ms + 1e-9); }),
+                   table.rows.end());
+}
+
 // What one needle's run folder says.
 struct NeedleRun : NeedleOutcome {
   std::string folder, reason;
@@ -133,6 +141,12 @@ NeedleRun read_run(const std::string& out_dir, const std::string& name) {
   }
   r.history = read_csv_table((fs::path(r.folder) / "history.csv").string());
   r.facets = read_csv_table((fs::path(r.folder) / "facet_forces.csv").string());
+  // A run that fired the cannula goes on past its insertion with the needle held: its curves and end loads are the
+  // insertion's, up to the instant its deflection is read (summary "needle_held": from_ms).
+  if (s.contains("needle_held") && s["needle_held"].is_object()) {
+    const double insertion_end_ms = number_or_nan(s["needle_held"], "from_ms");
+    for (CsvTable* table : {&r.history, &r.facets}) keep_rows_until(*table, insertion_end_ms);
+  }
   return r;
 }
 

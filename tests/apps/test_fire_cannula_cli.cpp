@@ -3,6 +3,7 @@
 // run without the firing, whose files say nothing of a firing), the sample lies within the groove's part in the tissue,
 // the frames mark the particles in the cannula, and a firing that cannot take tissue is refused before any folder exists.
 #include <catch2/catch.hpp>
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -70,6 +71,16 @@ TEST_CASE("needle run --fire-cannula takes a sample from the groove after the in
   INFO("deflection fired " << f.summary["deflection_mm"] << ", plain " << p.summary["deflection_mm"]);
   CHECK(f.summary["deflection_mm"].get<double>() == Approx(p.summary["deflection_mm"].get<double>()).epsilon(1e-6));
   CHECK(f.summary["needle_held"]["from_ms"].get<double>() == Approx(insertion_end_ms));
+  // A row at the insertion's end, once, as the plain run ends on one: the instant the deflection is read (the paper
+  // report's loads and curves stop there), then the stroke's rows.
+  const std::vector<double> fired_t = f.history.column("time_ms"), plain_t = p.history.column("time_ms");
+  const auto at_end = std::find(fired_t.begin(), fired_t.end(), plain_t.back());
+  REQUIRE(at_end != fired_t.end());
+  CHECK(std::count(fired_t.begin(), fired_t.end(), plain_t.back()) == 1);
+  CHECK(fired_t.back() > plain_t.back());
+  const size_t row = static_cast<size_t>(at_end - fired_t.begin());
+  CHECK(f.history.column("deflection_mm")[row] == Approx(p.history.column("deflection_mm").back()).epsilon(1e-6));
+  CHECK(f.history.column("insertion_mm")[row] == Approx(p.history.column("insertion_mm").back()));
 
   // The sample: tissue in the groove's part inside the block (1.2 mm), I_s within its extent, its mass its
   // volume's at the card's density.

@@ -41,6 +41,7 @@ void write_run(const fs::path& dir, const std::string& name, const FakeRun& r) {
                          {"floor_layer_length_mm", 22.0}, {"floor_length_mm", 22.0}, {"length_mm", 22.0}, {"volume_mm3", 0.4 * r.sample_I_s_mm},
                          {"floor_particles", 7}, {"floor_layer_particles", 100}};
     if (!r.sample_before_2026_11_29) written["sample"]["I_s_measure"] = "floor_layer_covered_mm";
+    written["needle_held"] = {{"from_ms", 30 * 0.13}};
   }
   std::ofstream(folder / "summary.json") << written.dump(2);
   const json scene = {{"tissue", {{"spacing_mm", 0.4}, {"path_refinement", 2}, {"path_half_width_mm", 1.2},
@@ -52,6 +53,13 @@ void write_run(const fs::path& dir, const std::string& name, const FakeRun& r) {
   std::ofstream facets(folder / "facet_forces.csv");
   facets << "time_ms,insertion_mm,top_fy_N,bottom_fy_N,shaft_fy_N\n";
   for (int k = 0; k <= 30; ++k) facets << k * 0.13 << "," << k << "," << -0.01 * k << "," << 0.005 * k << "," << r.shaft_fy_N * k / 30.0 << "\n";
+  if (std::isfinite(r.sample_I_s_mm)) {
+    // The cannula's stroke after the insertion's end (3.9 ms), the needle held at 30 mm: loads the report must not read.
+    for (int k = 1; k <= 5; ++k) {
+      history << 3.9 + 0.1 * k << ",30," << r.deflection_mm << "\n";
+      facets << 3.9 + 0.1 * k << ",30,9.99,9.99,9.99\n";
+    }
+  }
 }
 
 fs::path fresh(const std::string& name) {
@@ -564,7 +572,7 @@ TEST_CASE("needle paper with fired runs: I_s beside the measured lengths, its ta
   const std::map<std::string, double> measured = {{"SB", 12.5}, {"LMB", 12.9}, {"AMB", 9.9}, {"HMB", 8.6}};
   const std::map<std::string, double> deflection = {{"SB", -1.14}, {"LMB", 0.15}, {"AMB", 0.24}, {"HMB", 1.71}};
   for (const auto& [name, length] : measured) {
-    write_run(dir, name, {deflection.at(name), 0.9, 0, 1.7 * length});
+    write_run(dir, name, {deflection.at(name), 0.9, 0.05, 1.7 * length});
     write_run(replica, name, {deflection.at(name), 0.9, 0, name == "HMB" ? 1.7 * 10.5 : 1.7 * length, true});
   }
   REQUIRE(run("paper --report-only --no-tips --quiet --tissue-E-MPa 0.05 --out " + replica.string(), true).exit_code == 0);
@@ -574,6 +582,9 @@ TEST_CASE("needle paper with fired runs: I_s beside the measured lengths, its ta
   CHECK(md.find("Ranked by predicted I_s (longest first): LMB > SB > AMB > HMB") != std::string::npos);
   CHECK(md.find("| SB and LMB above AMB, AMB above HMB | met | 1 of 2 |") != std::string::npos);
   CHECK(md.find("| each ratio to SB within 0.15 of the measured (1.00, 1.03, 0.79, 0.69) | met (worst miss 0.00) | 1 of 2 |") != std::string::npos);
+  // The loads are the insertion's end's, not the stroke's after it (9.99 N on every facet).
+  CHECK(md.find("| SB | -0.150 | +0.000 | +0.050 | 100 (80) |") != std::string::npos);
+  CHECK(md.find("9.990") == std::string::npos);
   // The replica's row: read from its results.json, its I_s the layer's covered length, not the 22 mm of its I_s_mm.
   CHECK(md.find("| x + 0.1 | 21.25 | 1.03, 0.79, 0.84 | **not ranked**, **ratios missed** (worst 0.15) |") != std::string::npos);
 
