@@ -161,20 +161,21 @@ class InsertionRunModel : public RunModel {
     const double insertion_end = scene_.motion.end_time_ms();
     run_->step(time_ms() < insertion_end - 1e-12 ? std::min(end_time_ms, insertion_end) : end_time_ms);
     if (!at_insertion_end_ && time_ms() >= insertion_end - 1e-12) {
+      at_insertion_end_ = InsertionEnd{tip_displacement_now(), needle_model_->drive_displacement_mm(), run_groove_fill(*run_, built_, scene_),
+                                       strain_probes_json(run_strain_probes(*run_, built_, scene_), needle_model_->drive_displacement_mm().norm(),
+                                                          deflection_now())};
+      // A history and facet-force row at the insertion's end, the instant its deflection is read (the run without the
+      // firing ends on one): the report's loads and curves stop there (studies/paper_report.cpp). Written before the
+      // masses are retargeted below, which the contact's forces (impulses over the step) are read with.
+      if (output_) {
+        output_->record(*run_, tip_, at_insertion_end_->groove);
+        insertion_end_row_ms_ = time_ms();
+      }
       // The held needle takes no coupling: the tissue steps at the firing's own mass-scaled step.
       if (const TissueMassScaling* scaling = run_->tissue_dynamics().mass_scaling()) {
         const double target = scene_.cannula_firing.tissue_mass_scaling_dt_ms;
         insertion_mass_scaling_dt_ms_ = scaling->target_dt_ms();
         run_->tissue_dynamics().retarget_mass_scaling(target > 0 ? target : CannulaFiringOptions::kMassScalingGrowth * scaling->target_dt_ms());
-      }
-      at_insertion_end_ = InsertionEnd{tip_displacement_now(), needle_model_->drive_displacement_mm(), run_groove_fill(*run_, built_, scene_),
-                                       strain_probes_json(run_strain_probes(*run_, built_, scene_), needle_model_->drive_displacement_mm().norm(),
-                                                          deflection_now())};
-      // A history and facet-force row at the insertion's end, the instant its deflection is read (the run without the
-      // firing ends on one): the report's loads and curves stop there (studies/paper_report.cpp).
-      if (output_) {
-        output_->record(*run_, tip_, at_insertion_end_->groove);
-        insertion_end_row_ms_ = time_ms();
       }
     }
   }

@@ -16,6 +16,7 @@ void HeldNeedle::hold() {
   time_ms_ = inner_->time_ms();
   still_ = Eigen::MatrixX3d::Zero(inner_->positions_mm().rows(), 3);
   energy_ = inner_->energy();
+  reaction_N_ = inner_->drive_reaction_N();  // the drive's at the instant of the hold, until the supports' first step
   taken_mJ_ = energy_.kinetic_mJ;
   energy_.held_mJ += taken_mJ_;  // the supports take the kinetic energy out
   energy_.kinetic_mJ = 0;

@@ -81,6 +81,10 @@ TEST_CASE("needle run --fire-cannula takes a sample from the groove after the in
   const size_t row = static_cast<size_t>(at_end - fired_t.begin());
   CHECK(f.history.column("deflection_mm")[row] == Approx(p.history.column("deflection_mm").back()).epsilon(1e-6));
   CHECK(f.history.column("insertion_mm")[row] == Approx(p.history.column("insertion_mm").back()));
+  for (const char* force : {"contact_force_y_N", "drive_force_y_N"}) {
+    INFO(force);
+    CHECK(f.history.column(force)[row] == Approx(p.history.column(force).back()).epsilon(1e-6).margin(1e-12));
+  }
 
   // The sample: tissue in the groove's part inside the block (1.2 mm), I_s within its extent, its mass its
   // volume's at the card's density.
