@@ -56,6 +56,8 @@ def run_batch(args, sweep_path):
         command = [args.needle, "sweep", sweep_path, "--out", folder, "--jobs", str(args.jobs)]
     if args.threads:
         command += ["--threads", str(args.threads)]
+    if args.allow_other_code:
+        command.append("--allow-other-code")
     print("global_sensitivity:", " ".join(command), flush=True)
     status = subprocess.call(command)
     if status == 3:  # the table is written; some cases stopped or failed: the analysis leaves their points out
@@ -295,6 +297,8 @@ def main(argv):
     p.add_argument("--threads", type=int, default=0, help="threads a case (default: the cores divided among the jobs)")
     p.add_argument("--mpi", type=int, default=0, help="run each sweep on N MPI workers instead of --jobs")
     p.add_argument("--needle", default=os.path.join(root, "build", "apps", "needle"), help="the needle command")
+    p.add_argument("--allow-other-code", action="store_true",
+                   help="let a batch begun by another build of needle go on (needle sweep --allow-other-code; each case's summary names its build)")
     p.add_argument("--design-only", action="store_true", help="write the sweep files only")
     p.add_argument("--analyze-only", action="store_true", help="analyse the finished cases only")
     p.add_argument("--permutations", type=int, default=2000, help="permutations of the HSIC p-values (default 2000)")

@@ -459,5 +459,17 @@ with tempfile.TemporaryDirectory() as tmp:
     check(r.returncode == 2 and "--points" in r.stderr and not os.path.exists(os.path.join(tmp, "o")),
           f"--points beyond a batch is refused ({r.stderr.strip()})")
 
+    # --allow-other-code reaches `needle sweep` (a stand-in needle records its arguments and fails, so nothing runs).
+    fake = os.path.join(tmp, "fake_needle")
+    with open(fake, "w") as f:
+        f.write("#!/bin/sh\necho \"$@\" >> \"$(dirname \"$0\")/fake_args.txt\"\nexit 2\n")
+    os.chmod(fake, 0o755)
+    r = subprocess.run([sys.executable, script, "--study", bad, "--out", os.path.join(tmp, "p"), "--needle", fake, "--allow-other-code"],
+                       capture_output=True, text=True)
+    with open(os.path.join(tmp, "fake_args.txt")) as f:
+        fake_args = f.read()
+    check(r.returncode == 2 and fake_args.startswith("sweep ") and "--allow-other-code" in fake_args,
+          f"--allow-other-code is passed to needle sweep ({fake_args.strip()})")
+
 print(f"{len(failures)} failed" if failures else "all passed")
 sys.exit(1 if failures else 0)
