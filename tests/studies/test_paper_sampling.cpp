@@ -64,7 +64,7 @@ TEST_CASE("The sampling targets are judged on the length asked for: I_s, or the 
   CHECK(extent.worst_ratio_miss == Approx(std::abs(4.0 / 22 - 8.6 / 12.5)).epsilon(1e-9));
 }
 
-TEST_CASE("Each lattice is judged with the report's measured lengths; a replica without all four needles is left out", "[studies][cannula]") {
+TEST_CASE("Each lattice is judged with the report's measured lengths, and a replica without all four needles is left out", "[studies][cannula]") {
   const std::vector<SampledNeedle> report = needles(12.5, 12.9, 9.9, 8.6);
   // Replica a: I_s doubled (same ratios: met), its contact extent HMB 0.2 short of the measured ratio; replica b: HMB's I_s
   // above AMB's but its ratio (0.80) within 0.15 of the measured; replica c: no HMB.
