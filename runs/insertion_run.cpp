@@ -287,8 +287,8 @@ class InsertionRunModel : public RunModel {
     const TissueSample& touched_during_stroke = *sample_touched_during_stroke_;
     const CannulaStroke& s = firing_->stroke();
     summary["sample"] = {
-        {"I_s_mm", sample.I_s_mm},
-        {"I_s_measure", "floor_layer_covered_mm"},
+        {"I_s_mm", sample.I_s_mm()},
+        {"I_s_measure", kSampleLengthMeasure},
         {"floor_length_mm", sample.floor_length_mm},
         {"floor_covered_mm", sample.floor_covered_mm},
         {"floor_length_during_stroke_mm", touched_during_stroke.floor_length_mm},

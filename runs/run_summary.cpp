@@ -4,6 +4,7 @@
 
 #include "core/input_error.h"
 #include "runs/json_file.h"
+#include "solver/insertion/tissue_sample.h"
 
 namespace needle {
 
@@ -28,11 +29,11 @@ RunOutcome run_outcome(const nlohmann::json& s) {
 
 double sample_I_s_mm(const nlohmann::json& sample) {
   if (sample.contains("I_s_measure")) {
-    NEEDLE_REQUIRE(sample["I_s_measure"] == "floor_layer_covered_mm",
-                   fmt::format("summary.json: sample.I_s_measure {} is not one this build reads (floor_layer_covered_mm)", sample["I_s_measure"].dump()));
+    NEEDLE_REQUIRE(sample["I_s_measure"] == kSampleLengthMeasure,
+                   fmt::format("summary.json: sample.I_s_measure {} is not one this build reads ({})", sample["I_s_measure"].dump(), kSampleLengthMeasure));
     return number_or_nan(sample, "I_s_mm");
   }
-  return number_or_nan(sample, "floor_layer_covered_mm");
+  return number_or_nan(sample, kSampleLengthMeasure);
 }
 
 }  // namespace needle

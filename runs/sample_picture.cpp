@@ -27,7 +27,7 @@ RgbImage draw_sample_picture(const SamplePictureInput& in) {
   }
   const double lo = g.back_x_mm - 1, hi = g.front_x_mm + 1;
   LinePlot plot;
-  plot.title = fmt::format("The sample: I_s {:.2f} mm (the floor it rests on), {:.2f} mm in all, {:.3f} mm3", in.sample.I_s_mm,
+  plot.title = fmt::format("The sample: I_s {:.2f} mm (the floor it rests on), {:.2f} mm in all, {:.3f} mm3", in.sample.I_s_mm(),
                            in.sample.length_mm, in.sample.volume_mm3);
   plot.x_label = "x along the needle (mm; tip point A at 0)";
   plot.y_label = "y (mm)";

@@ -15,6 +15,7 @@
 #include "runs/provenance_json.h"
 #include "runs/run_summary.h"
 #include "studies/paper_observations.h"
+#include "solver/insertion/tissue_sample.h"
 #include "studies/paper_sampling.h"
 #include "studies/run_model_description.h"
 #include "runs/scene.h"
@@ -386,7 +387,7 @@ void write_paper_report(const PaperReportInput& in) {
     }
     if (std::isfinite(r.sample_I_s_mm))
       n["sample"] = {{"I_s_mm", r.sample_I_s_mm},
-                     {"I_s_measure", "floor_layer_covered_mm"},
+                     {"I_s_measure", kSampleLengthMeasure},
                      {"contact_extent_mm", r.sample_contact_extent_mm},
                      {"floor_layer_particles", r.sample_floor_layer_particles},
                      {"contact_particles", r.sample_floor_particles},

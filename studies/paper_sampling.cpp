@@ -59,12 +59,15 @@ SamplingVerdict judge_sampling(const std::vector<SampledNeedle>& needles, double
 }
 
 std::vector<SamplingLattice> judge_sampling_lattices(const std::vector<SampledNeedle>& needles, const std::vector<SampledReplica>& replicas) {
-  std::vector<SamplingLattice> out{{"this report", judge_sampling(needles), judge_sampling(needles, &SampledNeedle::contact_extent_mm)}};
+  std::vector<SamplingLattice> out{{"this report", needles, judge_sampling(needles), judge_sampling(needles, &SampledNeedle::contact_extent_mm)}};
   for (const SampledReplica& r : replicas) {
-    const std::vector<SampledNeedle> n = with_measured(r.needles, needles);
+    std::vector<SampledNeedle> n = with_measured(r.needles, needles);
     bool all_four = true;
     for (const char* name : {"SB", "LMB", "AMB", "HMB"}) all_four = all_four && find(n, name, &SampledNeedle::I_s_mm);
-    if (all_four) out.push_back({r.label, judge_sampling(n), judge_sampling(n, &SampledNeedle::contact_extent_mm)});
+    if (all_four) {
+      const SamplingVerdict I_s = judge_sampling(n), extent = judge_sampling(n, &SampledNeedle::contact_extent_mm);
+      out.push_back({r.label, std::move(n), I_s, extent});
+    }
   }
   return out;
 }
@@ -132,13 +135,10 @@ std::string sampling_section(const std::vector<SampledNeedle>& needles, const st
           "| lattice | I_s of SB (mm) | I_s ratios LMB, AMB, HMB | on I_s | the contact's extent: ratios LMB, AMB, HMB | on the contact's extent |\n"
           "|---|---|---|---|---|---|\n";
     for (const SamplingLattice& l : lattices) {
-      const std::vector<SampledNeedle>* lattice_needles = &needles;
-      for (const SampledReplica& r : replicas)
-        if (r.label == l.label) lattice_needles = &r.needles;
-      const SampledNeedle* lattice_sb = find(*lattice_needles, "SB", kIs);
+      const SampledNeedle* lattice_sb = find(l.needles, "SB", kIs);
       const auto ratios = [&](double SampledNeedle::*length) {
-        return fmt::format("{}, {}, {}", number(ratio_to_sb(*lattice_needles, "LMB", length), "{:.2f}"),
-                           number(ratio_to_sb(*lattice_needles, "AMB", length), "{:.2f}"), number(ratio_to_sb(*lattice_needles, "HMB", length), "{:.2f}"));
+        return fmt::format("{}, {}, {}", number(ratio_to_sb(l.needles, "LMB", length), "{:.2f}"),
+                           number(ratio_to_sb(l.needles, "AMB", length), "{:.2f}"), number(ratio_to_sb(l.needles, "HMB", length), "{:.2f}"));
       };
       md += fmt::format("| {} | {} | {} | {} | {} | {} |\n", l.label, number(lattice_sb ? lattice_sb->I_s_mm : std::nan(""), "{:.2f}"), ratios(kIs),
                         verdict_words(l.I_s), ratios(kContact), verdict_words(l.contact_extent));

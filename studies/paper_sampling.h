@@ -42,6 +42,7 @@ struct SampledReplica {
 // The two verdicts of each lattice: this report's first, then each replica with samples of all four needles.
 struct SamplingLattice {
   std::string label;
+  std::vector<SampledNeedle> needles;  // with this report's measured lengths
   SamplingVerdict I_s, contact_extent;
 };
 std::vector<SamplingLattice> judge_sampling_lattices(const std::vector<SampledNeedle>& needles, const std::vector<SampledReplica>& replicas);

@@ -67,7 +67,6 @@ TissueSample measure_tissue_sample(const TissueSampleInput& in) {
   out.floor_layer_particles = static_cast<std::int64_t>(layer_spans.size());
   extent_and_cover(std::move(floor_spans), out.floor_length_mm, out.floor_covered_mm);
   extent_and_cover(std::move(layer_spans), out.floor_layer_length_mm, out.floor_layer_covered_mm);
-  out.I_s_mm = out.floor_layer_covered_mm;
   return out;
 }
 

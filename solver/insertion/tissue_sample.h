@@ -42,12 +42,15 @@ struct TissueSample {
   std::int64_t particles = 0, floor_particles = 0;
   double length_mm = 0, floor_length_mm = 0, floor_covered_mm = 0, volume_mm3 = 0, mass_g = 0;
   double floor_layer_length_mm = 0, floor_layer_covered_mm = 0;
-  double I_s_mm = 0;  // floor_layer_covered_mm: the length compared with the paper's
+  double I_s_mm() const { return floor_layer_covered_mm; }  // the length compared with the paper's
   std::int64_t floor_layer_particles = 0;
   double back_x_mm = 0, front_x_mm = 0;  // the captured tissue's extent (reference frame; 0 when empty)
   std::vector<std::uint8_t> captured;    // per particle
   std::vector<std::uint8_t> in_floor_layer;  // per particle: captured, and in the floor's nearest layer (I_s covers these)
 };
+
+// The name of I_s's measure, written beside it in a run's summary (summary.json sample.I_s_measure).
+inline constexpr const char* kSampleLengthMeasure = "floor_layer_covered_mm";
 
 TissueSample measure_tissue_sample(const TissueSampleInput& input);
 

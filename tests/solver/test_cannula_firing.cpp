@@ -150,7 +150,7 @@ TEST_CASE("A cannula fired through free tissue without a needle cuts out a cylin
   CHECK(sample.volume_mm3 == Approx(closed_form_mm3).epsilon(0.04));
   CHECK(sample.length_mm == Approx(3.0 + 0.2).margin(0.05));  // the particles' half spacings beyond the block's faces
   CHECK(sample.floor_length_mm == 0);  // no groove, no floor
-  CHECK(sample.I_s_mm == 0);
+  CHECK(sample.I_s_mm() == 0);
   // Every particle of the wall's band was pushed to a face: none is left inside the wall behind the front.
   for (const Vec3d& x : p.position_mm) {
     const double r = radius(x);
@@ -233,7 +233,7 @@ TEST_CASE("The sample's lengths: the extent of the captured tissue, and I_s the 
   CHECK(s.floor_layer_particles == 2);
   CHECK(s.floor_layer_length_mm == Approx(1.1 - (-0.1)));
   CHECK(s.floor_layer_covered_mm == Approx(0.2 + 0.2));
-  CHECK(s.I_s_mm == Approx(0.2 + 0.2));  // I_s: the floor the layer covers, not its extent nor the contact's
+  CHECK(s.I_s_mm() == Approx(0.2 + 0.2));  // I_s: the floor the layer covers, not its extent nor the contact's
 }
 
 TEST_CASE("The needle's axis frame carries a point beside a translated and bent needle back to its place", "[solver][cannula]") {
