@@ -1,6 +1,7 @@
 #include "core/units.h"
 
 #include <cmath>
+#include <limits>
 
 namespace needle {
 
@@ -48,5 +49,20 @@ std::string canonical_suffix(Dimension d) {
 }
 
 double canonical_to_internal(Dimension d) { return d == Dimension::density ? 1e-3 : 1.0; }
+
+double internal_to_canonical(Dimension d, double internal) {
+  const double factor = canonical_to_internal(d);
+  const double quotient = internal / factor;
+  if (!std::isfinite(quotient) || quotient * factor == internal) return quotient;
+  // The reading multiplies by the factor, a monotone map: walk outwards from the quotient, nearest first.
+  double below = quotient, above = quotient;
+  for (int ulps = 1; ulps <= 8; ++ulps) {
+    below = std::nextafter(below, -std::numeric_limits<double>::infinity());
+    above = std::nextafter(above, std::numeric_limits<double>::infinity());
+    if (above * factor == internal) return above;
+    if (below * factor == internal) return below;
+  }
+  return quotient;
+}
 
 }  // namespace needle

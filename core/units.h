@@ -24,5 +24,10 @@ const char* dimension_name(Dimension dimension);
 // The canonical key suffix of a dimension ("_mm") and the factor from its unit to internal units.
 std::string canonical_suffix(Dimension dimension);
 double canonical_to_internal(Dimension dimension);
+// An internal value in the canonical unit, chosen to read back as exactly that internal value: a plain
+// division by the factor can land one ulp off (9 g/cm3 is 0.009 g/mm3, and 0.009 * 1e3 reads back as 9.000000000000002),
+// so a stored scene would not read back as the scene it was written from. The nearest canonical value that
+// reads back exactly; the plain quotient where none within a few ulps does (a value no input could give).
+double internal_to_canonical(Dimension dimension, double internal);
 
 }  // namespace needle

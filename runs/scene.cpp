@@ -408,7 +408,7 @@ json scene_to_json(const Scene& s) {
   needle["mesh"] = {{"order", n.mesh.order}, {"size_mm", n.mesh.size_mm}, {"tip_size_mm", n.mesh.tip_size_mm},
                     {"edge_size_mm", n.mesh.edge_size_mm}, {"shaft_size_mm", n.mesh.shaft_size_mm}, {"grading_mm", n.mesh.grading_mm}};
   needle["material"] = {{"youngs_modulus_MPa", n.material.youngs_modulus_MPa}, {"poisson_ratio", n.material.poisson_ratio},
-                        {"density_g_per_cm3", n.material.density_g_per_mm3 * 1e3}};
+                        {"density_g_per_cm3", internal_to_canonical(Dimension::density, n.material.density_g_per_mm3)}};
   // A model selected by its legacy key is written so (stored scenes read the same); another but the default by name.
   for (const NeedleModelEntry& m : needle_models())
     if (!m.legacy_key.empty()) needle[m.legacy_key] = n.model == m.name;
