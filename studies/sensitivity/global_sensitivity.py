@@ -15,10 +15,13 @@ surrogates are validated against.
     /usr/bin/python3 studies/sensitivity/global_sensitivity.py --out study --batches 2 --jobs 2   # design, run, analyse
     /usr/bin/python3 studies/sensitivity/global_sensitivity.py --out study --analyze-only         # the tables again
     /usr/bin/python3 studies/sensitivity/global_sensitivity.py --out study --batches 2 --points 8  # batch 1's first 8 points
+    /usr/bin/python3 studies/sensitivity/global_sensitivity.py --out study --batch 2              # batch 2 alone (the corners)
 
 A study file's "kriging_trend" ("constant", the default, or "linear") is the surrogates' trend; its "held_out":
 {"from_batch": K} adds the held-out check (study_held_out.py): the procedure fitted on batches 0..K-1 predicts the
 points of batch K on, from the design, before they run (analysis/held_out.csv), and is judged on them as they complete.
+Its "corners" make one batch the box's corners in the named factors (study_design.read_corners), predicted the same way
+from the points below "fitted_on_points_below" (analysis/corners_held_out.csv) and then part of the fit.
 
 Writes into --out: batch_K/sweep.json (the sweep file of batch K) and batch_K/sweep/ (its sweep folder), the same in
 batch_K_NAME/ for each replica NAME, and
@@ -40,7 +43,7 @@ from study_design import (StudyError, batch_cases, batch_folder, factor_value, n
                           replica_set, sweep_file, unit_design, write_batch, write_sweep_file)
 from study_runs import (MEASURED_MM, PLATEAU, POOLED_SD_MM, case_records, complete_rows, point_runs, read_points,  # noqa: E402,F401
                         replica_scatter, response_view, responses, within_point_scatter)
-from study_held_out import held_out_check, write_held_out  # noqa: E402
+from study_held_out import held_out_checks, write_held_out  # noqa: E402
 from study_surrogates import (MIN_Q2, RMSE_OVER_SCATTER, chaos_or_none, hsic_indices, joint_search,  # noqa: E402,F401
                               kriging_surrogate, run_distances)
 
@@ -195,9 +198,9 @@ def analyze(study, out, permutations=2000, top=3, root=None):
               "responses": resp, "hsic": {r: {n: {"r2_hsic": v[0], "p_value": v[1]} for n, v in table[r].items()} for r in resp},
               "replica_sd": scatter, "report_replica_sd": report_scatter,
               "within_point_sd": {r: {"sd": v[0], "dof": v[1]} for r, v in within.items()}, "surrogates": surrogates, "chaos": chaos, "joint": joint, "nearest_run_point": nearest, "measured_mm": MEASURED_MM}
-    held = held_out_check(study, records, rows, fitted, scatter, permutations, top) if study.get("held_out") else None
-    if held:
-        result["held_out"] = {k: v for k, v in held.items() if k != "rows"}
+    checks = held_out_checks(study, records, rows, fitted, scatter, permutations, top)
+    for name, check in checks:
+        result[name if name == "held_out" else f"{name}_held_out"] = {k: v for k, v in check.items() if k != "rows"}
     with open(os.path.join(folder, "surrogate.json.tmp"), "w") as f:
         json.dump(result, f, indent=1)
     os.replace(os.path.join(folder, "surrogate.json.tmp"), os.path.join(folder, "surrogate.json"))
@@ -274,8 +277,8 @@ def analyze(study, out, permutations=2000, top=3, root=None):
                   f"{MEASURED_MM['AMB'] - MEASURED_MM['LMB']:+.2f} +- 0.05 mm)")
     md.append(f"- two standard deviations of the experiment: {2 * POOLED_SD_MM:.2f} mm")
     md.append("")
-    if held:
-        md.extend(write_held_out(folder, held, study, fitted))
+    for name, check in checks:
+        md.extend(write_held_out(folder, check, study, fitted, name if name == "held_out" else f"{name}_held_out"))
     with open(os.path.join(folder, "hsic.md"), "w") as f:
         f.write("\n".join(md))
     plot_hsic(os.path.join(folder, "hsic.png"), study, table, resp)
@@ -291,6 +294,8 @@ def main(argv):
     p.add_argument("--study", default=os.path.join(root, "data", "studies", "global_sensitivity.json"), help="the study file")
     p.add_argument("--out", required=True, help="the study folder (created; reruns resume)")
     p.add_argument("--batches", type=int, default=1, help="run batches 0..N-1 of the design (default 1)")
+    p.add_argument("--batch", type=int, default=None,
+                   help="run batch K alone, the others as they stand (the study's corner batch, say, beside a partial batch)")
     p.add_argument("--points", type=int, default=0,
                    help="run only the first N points of the last batch (a partial batch; a later run with more, or without, extends it)")
     p.add_argument("--jobs", type=int, default=2, help="worker processes of each sweep (default 2)")
@@ -309,10 +314,13 @@ def main(argv):
             raise StudyError("--batches must be at least 1")
         if args.points < 0 or args.points > study["batch_points"]:
             raise StudyError(f"--points must be between 1 and the study's batch_points ({study['batch_points']})")
+        if args.batch is not None and args.batch < 0:
+            raise StudyError("--batch must be at least 0")
         if not args.analyze_only:
-            for b in range(args.batches):
+            for b in ([args.batch] if args.batch is not None else range(args.batches)):
                 for replica in replica_names(study):
-                    path = write_batch(study, args.out, b, replica, args.points if args.points and b == args.batches - 1 else None)
+                    last = args.batch if args.batch is not None else args.batches - 1
+                    path = write_batch(study, args.out, b, replica, args.points if args.points and b == last else None)
                     if not args.design_only:
                         if not os.access(args.needle, os.X_OK):
                             raise StudyError(f"{args.needle}: no needle command (build it: bash scripts/build.sh needle)")

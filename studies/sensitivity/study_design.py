@@ -39,6 +39,7 @@ def read_study(path):
         raise StudyError(f"{path}: 'batch_points' must be an integer of at least 2")
     if study.get("kriging_trend", "constant") not in ("constant", "linear"):
         raise StudyError(f"{path}: 'kriging_trend' must be \"constant\" or \"linear\"")
+    read_corners(study, path)
     held = study.get("held_out")
     if held is not None and not (isinstance(held, dict) and isinstance(held.get("from_batch"), int) and held["from_batch"] >= 1):
         raise StudyError(f"{path}: 'held_out' needs a 'from_batch' of at least 1 (the surrogates are fitted on the batches before it)")
@@ -56,6 +57,64 @@ def read_study(path):
         if moved:
             raise StudyError(f"{path}: replica '{r['name']}' sets {moved[0]}, a factor of the study: a replica repeats the design, it does not move it")
     return study
+
+
+def read_corners(study, path):
+    """A study file's "corners": {"batch": K, "factors": [names], "half_fraction": bool, "fitted_on_points_below": N}:
+    batch K is not the Sobol' sequence's next points but the corners of the box of the named factors (each at its
+    range's ends, every other factor at its range's middle), the whole 2^k factorial or, with "half_fraction", the half
+    whose last factor's end is the product of the others' (coded -1/+1, I = +AB..K: any k-1 of the factors see every
+    one of their corners). A surrogate's reach lies at the box's corners, where a Sobol' design of a few dozen points
+    has no run; the corners are predicted from the points below N before they run (study_held_out.py) and then join
+    the fit."""
+    corners = study.get("corners")
+    if corners is None:
+        return
+    if not isinstance(corners, dict):
+        raise StudyError(f"{path}: 'corners' must be an object")
+    batch = corners.get("batch")
+    if not (isinstance(batch, int) and not isinstance(batch, bool) and batch >= 1):
+        raise StudyError(f"{path}: 'corners' needs a 'batch' of at least 1 (the Sobol' batches before it are the points it is predicted from)")
+    names = corners.get("factors")
+    by_name = {f["name"]: f for f in study["factors"]}
+    if not (isinstance(names, list) and len(names) >= 2 and len(set(names)) == len(names)):
+        raise StudyError(f"{path}: 'corners' needs 'factors', at least two distinct factor names")
+    for name in names:
+        if name not in by_name:
+            raise StudyError(f"{path}: 'corners' names '{name}', not a factor of the study")
+        if "range" not in by_name[name]:
+            raise StudyError(f"{path}: 'corners' names '{name}', a factor of levels: a corner is a range's end")
+    if not isinstance(corners.get("half_fraction", False), bool):
+        raise StudyError(f"{path}: 'corners': 'half_fraction' is true or false")
+    count = len(corner_units(study, corners))
+    if count > study["batch_points"]:
+        raise StudyError(f"{path}: 'corners' makes {count} points, more than a batch's {study['batch_points']} (batch_points)")
+    below = corners.get("fitted_on_points_below")
+    if not (isinstance(below, int) and not isinstance(below, bool) and 4 <= below <= batch * study["batch_points"]):
+        raise StudyError(f"{path}: 'corners' needs 'fitted_on_points_below': the points the predictions are fitted on "
+                         f"(at least 4, at most the {batch * study['batch_points']} points of the batches before it)")
+
+
+def corner_units(study, corners=None):
+    """The corner batch's points in unit coordinates, in standard order (the first factor alternating fastest)."""
+    corners = corners if corners is not None else study["corners"]
+    names = corners["factors"]
+    free = names[:-1] if corners.get("half_fraction") else names
+    points = []
+    for k in range(2 ** len(free)):
+        signs = {name: (1 if (k >> i) & 1 else -1) for i, name in enumerate(free)}
+        if corners.get("half_fraction"):
+            product = 1
+            for v in signs.values():
+                product *= v
+            signs[names[-1]] = product
+        points.append([0.5 if f["name"] not in signs else (1.0 if signs[f["name"]] > 0 else 0.0) for f in study["factors"]])
+    return points
+
+
+def corner_batch(study):
+    """The batch of box corners (read_corners), or None."""
+    return study["corners"]["batch"] if study.get("corners") else None
 
 
 def replica_names(study):
@@ -110,7 +169,10 @@ def batch_cases(study, batch, points_limit=None):
     """The design points of one batch, each run on every needle: [(point index, needle, {key: value})]; with
     points_limit, only the batch's first points_limit points (a partial batch, which the whole batch later extends)."""
     n = study["batch_points"]
-    points = unit_design(len(study["factors"]), (batch + 1) * n)[batch * n:]
+    if batch == corner_batch(study):
+        points = corner_units(study)
+    else:
+        points = unit_design(len(study["factors"]), (batch + 1) * n)[batch * n:]
     if points_limit is not None:
         points = points[:points_limit]
     cases = []

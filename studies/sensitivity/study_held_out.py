@@ -1,4 +1,5 @@
-"""The held-out check of a study's surrogates: a study file's "held_out": {"from_batch": K}.
+"""The held-out checks of a study's surrogates: a study file's "held_out": {"from_batch": K}, and its "corners"
+(study_design.read_corners: the box's corners, predicted from the points below "fitted_on_points_below").
 
 A surrogate's leave-one-out Q2 is computed on the points its form was chosen on. The held-out check asks the harder
 question: the analysis's own procedure (each response's HSIC screen, its most influential factors, the kriging with the
@@ -14,13 +15,40 @@ import os
 
 from study_runs import response_view, within_point_scatter
 from study_surrogates import MIN_Q2, RMSE_OVER_SCATTER, data_sd, fit_kriging, hsic_indices, surrogate_validated
-from study_design import unit_coordinate
+from study_design import corner_batch, unit_coordinate
+
+
+def corner_points(study, records):
+    """The design points of the corner batch, whether run or not (none without "corners")."""
+    batch = corner_batch(study)
+    if batch is None:
+        return []
+    n = study["batch_points"]
+    return sorted(p for p in records if batch * n <= p < (batch + 1) * n)
 
 
 def held_out_points(study, records):
-    """The design points of the held-out batches (those from held_out.from_batch on), whether run or not."""
+    """The design points of the held-out batches (those from held_out.from_batch on, the corners left to their own
+    check), whether run or not."""
     first = study["held_out"]["from_batch"] * study["batch_points"]
-    return sorted(p for p in records if p >= first)
+    corners = set(corner_points(study, records))
+    return sorted(p for p in records if p >= first and p not in corners)
+
+
+def held_out_checks(study, records, rows, responses, scatter, permutations=2000, top=3):
+    """Each held-out check the study declares: [(name, check)], "held_out" (batch K on, fitted on the batches before)
+    and "corners" (the corner batch, fitted on the complete points below fitted_on_points_below)."""
+    checks = []
+    if study.get("held_out"):
+        first = study["held_out"]["from_batch"] * study["batch_points"]
+        checks.append(("held_out", held_out_check(study, records, rows, responses, scatter, permutations, top,
+                                                  lambda p: p < first, held_out_points(study, records))))
+    if study.get("corners"):
+        below = study["corners"]["fitted_on_points_below"]
+        corners = set(corner_points(study, records))
+        checks.append(("corners", held_out_check(study, records, rows, responses, scatter, permutations, top,
+                                                 lambda p: p < below and p not in corners, sorted(corners))))
+    return checks
 
 
 def predict(study, fit_rows, response, noise_sd, points_values, permutations, top):
@@ -44,18 +72,17 @@ def predict(study, fit_rows, response, noise_sd, points_values, permutations, to
     return names, q2, rmse, predictions
 
 
-def held_out_check(study, records, rows, responses, scatter, permutations=2000, top=3):
-    """{"fitted_points", "points", "responses": {response: {...}}, "rows": [...]}: each response's predictions at the
-    held-out points, the observed means where a point is complete, and the verdict. The noise (the kriging's nugget,
-    the sd of a prediction, the bar) is the fitted points' own where the study has replicas, else `scatter`."""
-    first = study["held_out"]["from_batch"] * study["batch_points"]
-    fit_rows = [r for r in rows if r["point"] < first]
-    observed = {r["point"]: r for r in rows if r["point"] >= first}
+def held_out_check(study, records, rows, responses, scatter, permutations, top, fitted, points):
+    """{"fitted_points", "points", "responses": {response: {...}}, "rows": [...]}: each response's procedure fitted on
+    the complete rows whose point `fitted` accepts, its predictions at `points`, the observed means where a point is
+    complete, and the verdict. The noise (the kriging's nugget, the sd of a prediction, the bar) is the fitted points'
+    own where the study has replicas, else `scatter`."""
+    fit_rows = [r for r in rows if fitted(r["point"])]
+    observed = {r["point"]: r for r in rows if r["point"] in set(points)}
     # The runs' noise as the fitted points alone measure it (their replicas), so that nothing of the held-out points
     # enters the predictions; without replicas, the analysis's (the paper report's).
     within = within_point_scatter(study, fit_rows)
     scatter = {r: v[0] for r, v in within.items()} if within else scatter
-    points = held_out_points(study, records)
     runs_per_point = 1 + len(study.get("replicas", []))
     table = [{"point": p, **{f["name"]: records[p]["values"][f["key"]] for f in study["factors"]},
               "runs": observed[p]["runs"] if p in observed else 0} for p in points]
@@ -87,25 +114,33 @@ def held_out_check(study, records, rows, responses, scatter, permutations=2000, 
     return {"fitted_points": len(fit_rows), "top": top, "points": points, "responses": summary, "rows": table}
 
 
-def write_held_out(folder, check, study, responses):
-    """held_out.csv (one row a held-out point: its factors, each response's prediction, sd and observed mean) and the
-    Markdown lines of the check."""
+def write_held_out(folder, check, study, responses, name="held_out"):
+    """NAME.csv (one row a held-out point: its factors, each response's prediction, sd and observed mean) and the
+    Markdown lines of the check ("held_out": batch K on; "corners": the corner batch)."""
     columns = ["point"] + [f["name"] for f in study["factors"]] + ["runs"] + [
         f"{r}_{k}" for r in responses for k in ("predicted", "sd", "observed")]
-    path = os.path.join(folder, "held_out.csv")
+    path = os.path.join(folder, f"{name}.csv")
     with open(path + ".tmp", "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(columns)
         for row in check["rows"]:
             w.writerow(["" if row.get(c) is None else (f"{row[c]:.6g}" if isinstance(row[c], float) else row[c]) for c in columns])
     os.replace(path + ".tmp", path)
-    first = study["held_out"]["from_batch"]
-    md = [f"## Held out: the surrogates fitted on batches 0..{first - 1} ({check['fitted_points']} points) predict the "
-          f"{len(check['points'])} points of batch {first} on", "",
+    if name == "corners_held_out":
+        c = study["corners"]
+        md = [f"## Held out: the surrogates fitted on the {check['fitted_points']} complete points below point {c['fitted_on_points_below']} "
+              f"predict the {len(check['points'])} corners of batch {c['batch']} ({'half of ' if c.get('half_fraction') else ''}"
+              f"the box's corners in {', '.join(c['factors'])}; the other factors at their middle)", ""]
+    else:
+        first = study["held_out"]["from_batch"]
+        md = [f"## Held out: the surrogates fitted on batches 0..{first - 1} ({check['fitted_points']} points) predict the "
+              f"{len(check['points'])} points of batch {first} on (the corners apart)", ""]
+    md += [
           f"Each response's procedure as above (its {check['top']} most influential factors by HSIC, "
           f"the kriging with a {study.get('kriging_trend', 'constant')} trend and the runs' noise), fitted without the held-out points; "
           f"validated by the leave-one-out rule (Q2 over the held-out points >= {MIN_Q2}, or their RMSE within {RMSE_OVER_SCATTER} times "
-          "the noise of their means). The predictions come from the design alone (held_out.csv), so they stand before the runs.", "",
+          "the noise of their means). The predictions come from the design alone "
+          f"({name}.csv), so they stand before the runs.", "",
           "| response | factors | fitted LOO Q2 | held-out points run | RMSE | bar | Q2 | mean error | within 2 sd | validated |",
           "|---|---|---|---|---|---|---|---|---|---|"]
     for r in responses:

@@ -4,6 +4,7 @@ point's replicas and the scatter between them, and the paper report's replicas' 
 import json
 import math
 import os
+import re
 import statistics
 
 from study_design import StudyError, batch_cases, batch_folder, replica_names
@@ -29,8 +30,9 @@ def read_points(study, out):
     """Every design point's runs, from the batches' case records: {point: {"values": {key: value}, "runs": {replica:
     {needle: entry}}}}, the plain run under the replica "" (replica_names)."""
     records = {}
-    batch = 0
-    while os.path.exists(os.path.join(batch_folder(out, batch), "sweep.json")):
+    present = sorted(int(m.group(1)) for m in (re.fullmatch(r"batch_(\d+)", name) for name in (os.listdir(out) if os.path.isdir(out) else []))
+                     if m and os.path.exists(os.path.join(batch_folder(out, int(m.group(1))), "sweep.json")))
+    for batch in present:  # a batch run alone (--batch) may follow a gap
         for point, needle, values in batch_cases(study, batch):
             records.setdefault(point, {"values": values, "runs": {name: {} for name in replica_names(study)}})
         for replica in replica_names(study):
@@ -49,7 +51,6 @@ def read_points(study, out):
                     entry["floor_contact"] = (s.get("groove") or {}).get("floor_contact_fraction")
                     entry["lip_thickness_mm"] = (s.get("lip_release") or {}).get("lip_thickness_mm", 0.0)  # none: no lip
                 records[point]["runs"][replica][needle] = entry
-        batch += 1
     return records
 
 
