@@ -12,6 +12,9 @@
 - A partial batch (--points) is the whole batch's first points, which the whole batch later extends. The held-out
   check predicts batch 1 from batch 0 before it runs, the runs leave the predictions as they were, the known function's
   predictions hold and an offset of 0.3 in batch 1's ratios fails the check.
+- The box's corners as a batch ("corners"): the half fraction's defining relation and projections, the other factors at
+  their middle, the corners predicted before they run from the points below the declared bound (and refused with one
+  line where the study file's "corners" is wrong); --batch K runs that batch alone.
 - One more parameter fitted honestly (second_parameter.py): on ratios linear in the value, each fit and each held-out
   prediction has a closed form; its sweep file passes `needle sweep --count`.
 - Bad study files are refused with one line and exit 2.
@@ -369,6 +372,71 @@ with tempfile.TemporaryDirectory() as tmp:
           f"batch 1's ratios offset by 0.3 from batch 0's: the held-out check fails (AMB's mean error {off['ratio_AMB']['bias']:+.3f}, "
           f"Q2 LMB {off['ratio_LMB']['q2']:.2f}, AMB {off['ratio_AMB']['q2']:.2f})")
 
+# The box's corners as a batch of their own ("corners"): the half fraction's points satisfy I = +ABCD and any three of
+# the four factors see all eight of their corners, the others stand at their middle; the corners are predicted from
+# the points below fitted_on_points_below before they run (the batch-K check leaves them out), the runs do not move
+# the predictions, the known function's corners hold and an offset of 0.6 there fails.
+four = ["friction", "groove_start_mm", "crack_reach_mm", "E_MPa"]
+half = dict(study, batch_points=24, corners={"batch": 2, "factors": four, "half_fraction": True, "fitted_on_points_below": 36})
+units = gs.corner_units(half)
+index = {f["name"]: i for i, f in enumerate(half["factors"])}
+coded = [[2 * u[index[name]] - 1 for name in four] for u in units]
+check(len(units) == 8 and all(c[0] * c[1] * c[2] * c[3] == 1 for c in coded), "the half fraction: 8 corners, each with I = +ABCD")
+from itertools import combinations  # noqa: E402
+check(all(len({tuple(c[i] for i in trio) for c in coded}) == 8 for trio in combinations(range(4), 3)),
+      "any three of the four factors see all eight of their corners")
+check(all(u[i] == 0.5 for u in units for f, i in index.items() if f not in four), "the other factors stand at their middle")
+full = dict(half, corners=dict(half["corners"], half_fraction=False))
+check(len(gs.corner_units(full)) == 16 and len({tuple(u) for u in gs.corner_units(full)}) == 16, "the whole factorial: 16 distinct corners")
+corner_cases = gs.batch_cases(half, 2)
+first_case = corner_cases[0][2]
+check(corner_cases[0][0] == 48 and len(corner_cases) == 8 * len(half["needles"])
+      and first_case["tissue.friction"] == 0.05 and first_case["needle.groove_start_mm"] == 3.0
+      and first_case["cannula.outer_diameter_mm"] == 1.27,
+      f"the corner batch holds points 48..55, each factor at a range's end or its middle ({first_case['cannula.outer_diameter_mm']})")
+check(gs.batch_cases(half, 1) == gs.batch_cases(dict(half, corners=None), 1), "the Sobol' batches are not moved by the corners")
+
+with tempfile.TemporaryDirectory() as tmp:
+    def write_corner_records(batch, points_limit=None, offset=0.0):
+        gs.write_batch(half, tmp, batch, "", points_limit)
+        for k, (point, needle_name, values) in enumerate(gs.batch_cases(half, batch, points_limit)):
+            case_dir = os.path.join(tmp, f"batch_{batch}", "sweep", "cases", f"case_{k:04d}")
+            os.makedirs(case_dir, exist_ok=True)
+            deflection, _ = truth(values)
+            value = deflection[needle_name] + (offset * deflection["SB"] if needle_name != "SB" else 0.0)
+            with open(os.path.join(case_dir, "case.json"), "w") as f:
+                json.dump({"label": f"point {point:03d} {needle_name}", "status": "finished", "deflection_mm": value,
+                           "groove_fill": 0.9, "runtime_s": 1.0}, f)
+
+    linear = dict(half, kriging_trend="linear", held_out={"from_batch": 1})
+    half = linear
+    write_corner_records(0)
+    write_corner_records(1, 12)
+    gs.write_batch(half, tmp, 2)
+    before = gs.analyze(half, tmp, permutations=200)
+    corners_before = before["corners_held_out"]
+    check(corners_before["fitted_points"] == 36 and corners_before["points"] == list(range(48, 56))
+          and corners_before["responses"]["ratio_AMB"]["observed_points"] == 0,
+          "the corners are predicted from the 36 points below 36 before they run")
+    check(before["held_out"]["points"] == list(range(24, 48)), "batch 1's check leaves the corners to their own")
+    with open(os.path.join(tmp, "analysis", "corners_held_out.csv")) as f:
+        predicted_before = [line.split(",")[-9:] for line in f.read().splitlines()[1:]]
+    write_corner_records(1)  # more of batch 1 (points 36-47): below the corners' fit set's bound? no: they stay out of it
+    write_corner_records(2)
+    after = gs.analyze(half, tmp, permutations=200)
+    with open(os.path.join(tmp, "analysis", "corners_held_out.csv")) as f:
+        predicted_after = [[cell for i, cell in enumerate(line.split(",")[-9:]) if i % 3 != 2] for line in f.read().splitlines()[1:]]
+    check(predicted_after == [[cell for i, cell in enumerate(row) if i % 3 != 2] for row in predicted_before],
+          "neither the corners' runs nor batch 1's later points move the corners' predictions")
+    ok = after["corners_held_out"]["responses"]
+    check(all(ok[r]["observed_points"] == 8 and ok[r]["validated"] for r in ("ratio_LMB", "ratio_AMB")),
+          "on the known function the corners' predictions hold (RMSE LMB {:.4f}, AMB {:.4f})".format(ok["ratio_LMB"]["rmse"], ok["ratio_AMB"]["rmse"]))
+    check(after["points_complete"] == 56, f"the corners then join the fit ({after['points_complete']} points)")
+    write_corner_records(2, offset=0.6)  # the corners spread widely, so Q2 over them forgives a smaller offset
+    off = gs.analyze(half, tmp, permutations=200)["corners_held_out"]["responses"]
+    check(not off["ratio_AMB"]["validated"] and abs(off["ratio_AMB"]["bias"] - 0.6) < 0.02,
+          f"the corners offset by 0.6: their check fails (AMB's mean error {off['ratio_AMB']['bias']:+.3f}, Q2 {off['ratio_AMB']['q2']:.2f})")
+
 # One more parameter fitted honestly (second_parameter.py): ratios linear in the value, so every fit has a closed form.
 import second_parameter as sp  # noqa: E402
 
@@ -459,6 +527,22 @@ with tempfile.TemporaryDirectory() as tmp:
     check(r.returncode == 2 and "--points" in r.stderr and not os.path.exists(os.path.join(tmp, "o")),
           f"--points beyond a batch is refused ({r.stderr.strip()})")
 
+    bad_corners = os.path.join(tmp, "bad_corners.json")
+    for corners, words in (({"batch": 0, "factors": ["a", "b"], "fitted_on_points_below": 4}, "'batch' of at least 1"),
+                           ({"batch": 1, "factors": ["a", "z"], "fitted_on_points_below": 4}, "'z', not a factor"),
+                           ({"batch": 1, "factors": ["a", "c"], "fitted_on_points_below": 4}, "a factor of levels"),
+                           ({"batch": 1, "factors": ["a", "b", "d"], "fitted_on_points_below": 4}, "more than a batch's 4"),
+                           ({"batch": 1, "factors": ["a", "b"]}, "fitted_on_points_below")):
+        with open(bad_corners, "w") as f:
+            json.dump({"needles": ["SB"], "batch_points": 4, "corners": corners,
+                       "factors": [{"name": "a", "key": "tissue.friction", "range": [0.1, 0.3]},
+                                   {"name": "b", "key": "needle.groove_start_mm", "range": [3, 6]},
+                                   {"name": "c", "key": "tissue.separation.needle_cut", "levels": [True, False]},
+                                   {"name": "d", "key": "tissue.contact.crack_reach_mm", "range": [0, 1]}]}, f)
+        r = subprocess.run([sys.executable, script, "--study", bad_corners, "--out", os.path.join(tmp, "o"), "--design-only"], capture_output=True, text=True)
+        check(r.returncode == 2 and words in r.stderr and not os.path.exists(os.path.join(tmp, "o")),
+              f"a bad 'corners' is refused ({r.stderr.strip()})")
+
     # --allow-other-code reaches `needle sweep` (a stand-in needle records its arguments and fails, so nothing runs).
     fake = os.path.join(tmp, "fake_needle")
     with open(fake, "w") as f:
@@ -470,6 +554,22 @@ with tempfile.TemporaryDirectory() as tmp:
         fake_args = f.read()
     check(r.returncode == 2 and fake_args.startswith("sweep ") and "--allow-other-code" in fake_args,
           f"--allow-other-code is passed to needle sweep ({fake_args.strip()})")
+
+# --batch K runs that batch alone (the corner batch beside a partial one): the stand-in needle sees batch 2's sweeps only.
+with tempfile.TemporaryDirectory() as tmp:
+    fake = os.path.join(tmp, "fake_needle")
+    with open(fake, "w") as f:
+        f.write("#!/bin/sh\necho \"$@\" >> \"$(dirname \"$0\")/fake_args.txt\"\nexit 2\n")
+    os.chmod(fake, 0o755)
+    study_file = os.path.join(tmp, "corners.json")
+    with open(study_file, "w") as f:
+        json.dump(dict(half, replicas=[{"name": "y0.1", "set": {"tissue.offset_y_mm": 0.1}}]), f)
+    r = subprocess.run([sys.executable, os.path.join(source, "studies", "sensitivity", "global_sensitivity.py"), "--study", study_file,
+                        "--out", os.path.join(tmp, "s"), "--needle", fake, "--batch", "2"], capture_output=True, text=True)
+    args_file = os.path.join(tmp, "fake_args.txt")
+    swept = [line.split()[1] for line in open(args_file).read().splitlines()] if os.path.exists(args_file) else [r.stderr.strip()]
+    check(r.returncode == 2 and swept == [os.path.join(tmp, "s", "batch_2", "sweep.json")] and not os.path.exists(os.path.join(tmp, "s", "batch_0")),
+          f"--batch 2 writes and runs batch 2 alone ({swept})")
 
 print(f"{len(failures)} failed" if failures else "all passed")
 sys.exit(1 if failures else 0)
