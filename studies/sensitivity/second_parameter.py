@@ -19,7 +19,8 @@ thickness (the run's summary.json, lip_release.lip_thickness_mm) on; a needle wi
 runs only unset. Between its last value and its lip thickness a needle is interpolated towards the unset run.
 
 Writes into --out: sweep.json and sweep/ (the runs), and second_parameter.json and second_parameter.md (the tables).
-`--runs` analyses sweep folders run elsewhere (several: their cases are read by label).
+`--runs` analyses sweep folders run elsewhere (several: their cases are read by label); `--replica-runs` adds the
+same design run on other lattices, and the ratios analysed are the mean over the lattices.
 """
 import argparse
 import json
@@ -126,6 +127,15 @@ def ratios_from(deltas, lips, values=None, lip_depth=False):
     return ratios
 
 
+def mean_ratios(lattices):
+    """The mean over lattices (replicas of the same design, e.g. the particles shifted 0.1 mm in y) of each value's
+    ratios and SB's delta, each lattice's as ratios_from gives it; a value is kept only where every lattice has it."""
+    common = set(lattices[0])
+    for r in lattices[1:]:
+        common &= set(r)
+    return {v: {k: sum(r[v][k] for r in lattices) / len(lattices) for k in lattices[0][v]} for v in sorted(common)}
+
+
 def interpolate(ratios, needle, value):
     xs = sorted(ratios)
     if value <= xs[0]:
@@ -178,7 +188,8 @@ def analyse(key, ratios):
 def markdown(result):
     key = result["key"]
     md = [f"# One more parameter, `{key}`, fitted honestly", ""]
-    md.append("The ratios to SB as run (the default model at 30 mm; E calibrated on SB leaves delta_X = -1.14 mm x ratio_X):")
+    md.append("The ratios to SB as run (the default model at 30 mm; E calibrated on SB leaves delta_X = -1.14 mm x ratio_X)"
+              + (f", each the mean over {result['lattices']} lattices (--replica-runs):" if result.get("lattices", 1) > 1 else ":"))
     md.append("")
     md.append(f"| {key} | delta_SB (mm) | LMB/SB | AMB/SB | HMB/SB |")
     md.append("|---|---|---|---|---|")
@@ -222,6 +233,9 @@ def main(argv):
     p.add_argument("--out", required=True, help="the study folder (created; reruns resume)")
     p.add_argument("--runs", nargs="+", metavar="SWEEP_FOLDER",
                    help="with --analyze-only: the sweep folders to read (default: OUT/sweep)")
+    p.add_argument("--replica-runs", nargs="+", metavar="SWEEP_FOLDER", default=[],
+                   help="with --analyze-only: each folder the same design run on another lattice (a replica); the ratios "
+                        "analysed are the mean over the lattices, as the global study's are")
     p.add_argument("--jobs", type=int, default=2, help="worker processes (default 2)")
     p.add_argument("--travel-mm", type=float, default=30.0, help="insertion travel (default 30, the paper's)")
     p.add_argument("--needle", default=os.path.join(root, "build", "apps", "needle"), help="the needle command")
@@ -266,8 +280,8 @@ def main(argv):
             raise StudyError("--record and --fit-on go together")
         if args.round <= 0:
             raise StudyError(f"--round {args.round}: give a positive step")
-        if args.runs and not args.analyze_only:
-            raise StudyError("--runs reads finished sweeps: give it with --analyze-only")
+        if (args.runs or args.replica_runs) and not args.analyze_only:
+            raise StudyError("--runs and --replica-runs read finished sweeps: give them with --analyze-only")
         if not args.analyze_only:
             os.makedirs(args.out, exist_ok=True)
             path = write_sweep_file(os.path.join(args.out, "sweep.json"),
@@ -276,11 +290,16 @@ def main(argv):
             if status not in (0, 3):  # 3: some cases did not finish; the values whose four needles did are analysed
                 raise StudyError(f"needle sweep exited {status}")
         os.makedirs(args.out, exist_ok=True)
-        deltas, lips, problems = read_runs(args.runs or [os.path.join(args.out, "sweep")])
-        ratios = ratios_from(deltas, lips, values, args.lip_depth)
+        lattices, problems = [], []
+        for folders in [args.runs or [os.path.join(args.out, "sweep")]] + [[f] for f in args.replica_runs]:
+            deltas, lips, missing = read_runs(folders)
+            lattices.append(ratios_from(deltas, lips, values, args.lip_depth))
+            problems += missing
+        ratios = mean_ratios(lattices)
         for line in problems:
             print("second_parameter: not finished:", line)
         result = analyse(args.key, ratios)
+        result["lattices"] = len(lattices)
         with open(os.path.join(args.out, "second_parameter.json"), "w") as f:
             json.dump(result, f, indent=1)
         if args.record:

@@ -457,6 +457,13 @@ check(abs(amb_only["value"] - (5.0 + 0.2 / 0.3)) < 0.01 and abs(amb_only["errors
 held_amb = next(h for h in shifted["leave_one_out"] if h["held_out"] == "AMB")
 check(abs(held_amb["value"] - 5.0) < 0.01 and abs(held_amb["error_mm"] - (-1.14 * -0.2)) < 0.01,
       f"second parameter: AMB held out is predicted from the value LMB and HMB fit, its error the offset's ({held_amb['error_mm']:+.3f} mm)")
+# Replicas (--replica-runs): each lattice's ratios, then their mean; a value one lattice lacks is left out.
+lattice_a, lattice_b = linear_ratios(0.1), linear_ratios(-0.1)
+del lattice_b[6.0]
+both = sp.mean_ratios([lattice_a, lattice_b])
+check(sorted(both) == [3.0, 4.0, 5.0] and all(abs(both[v]["AMB"] - linear_ratios(0.0)[v]["AMB"]) < 1e-12 for v in both)
+      and all(both[v]["LMB"] == linear_ratios(0.0)[v]["LMB"] for v in both),
+      "second parameter: two lattices' ratios averaged, value by value, where both have it")
 with tempfile.TemporaryDirectory() as tmp:
     path = os.path.join(tmp, "sweep.json")
     with open(path, "w") as f:
@@ -493,6 +500,10 @@ with tempfile.TemporaryDirectory() as tmp:
                         "--out", os.path.join(tmp, "o")], capture_output=True, text=True)
     check(r.returncode == 2 and "--lip-depth" in r.stderr and not os.path.exists(os.path.join(tmp, "o")),
           f"per-needle values without --lip-depth are refused, nothing written ({r.stderr.strip()})")
+    r = subprocess.run([sys.executable, script, "--key", "tissue.friction", "--values", "0.1,0.2", "--replica-runs", tmp,
+                        "--out", os.path.join(tmp, "o")], capture_output=True, text=True)
+    check(r.returncode == 2 and "--analyze-only" in r.stderr and not os.path.exists(os.path.join(tmp, "o")),
+          f"--replica-runs without --analyze-only is refused, nothing written ({r.stderr.strip()})")
 
 # Bad study files.
 with tempfile.TemporaryDirectory() as tmp:
