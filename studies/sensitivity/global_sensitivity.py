@@ -39,7 +39,7 @@ import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from study_design import (StudyError, batch_cases, batch_folder, factor_value, numeric, read_study, replica_names,  # noqa: E402,F401
+from study_design import (StudyError, batch_cases, batch_folder, corner_units, factor_value, numeric, read_study, replica_names,  # noqa: E402,F401
                           replica_set, sweep_file, unit_design, write_batch, write_sweep_file)
 from study_runs import (MEASURED_MM, PLATEAU, POOLED_SD_MM, case_records, complete_rows, point_runs, read_points,  # noqa: E402,F401
                         replica_scatter, response_view, responses, within_point_scatter)
