@@ -200,7 +200,7 @@ def analyze(study, out, permutations=2000, top=3, root=None):
               "within_point_sd": {r: {"sd": v[0], "dof": v[1]} for r, v in within.items()}, "surrogates": surrogates, "chaos": chaos, "joint": joint, "nearest_run_point": nearest, "measured_mm": MEASURED_MM}
     checks = held_out_checks(study, records, rows, fitted, scatter, permutations, top)
     for name, check in checks:
-        result[name if name == "held_out" else f"{name}_held_out"] = {k: v for k, v in check.items() if k != "rows"}
+        result[name] = {k: v for k, v in check.items() if k != "rows"}
     with open(os.path.join(folder, "surrogate.json.tmp"), "w") as f:
         json.dump(result, f, indent=1)
     os.replace(os.path.join(folder, "surrogate.json.tmp"), os.path.join(folder, "surrogate.json"))
@@ -278,7 +278,7 @@ def analyze(study, out, permutations=2000, top=3, root=None):
     md.append(f"- two standard deviations of the experiment: {2 * POOLED_SD_MM:.2f} mm")
     md.append("")
     for name, check in checks:
-        md.extend(write_held_out(folder, check, study, fitted, name if name == "held_out" else f"{name}_held_out"))
+        md.extend(write_held_out(folder, check, study, fitted, name))
     with open(os.path.join(folder, "hsic.md"), "w") as f:
         f.write("\n".join(md))
     plot_hsic(os.path.join(folder, "hsic.png"), study, table, resp)

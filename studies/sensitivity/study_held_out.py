@@ -37,7 +37,8 @@ def held_out_points(study, records):
 
 def held_out_checks(study, records, rows, responses, scatter, permutations=2000, top=3):
     """Each held-out check the study declares: [(name, check)], "held_out" (batch K on, fitted on the batches before)
-    and "corners" (the corner batch, fitted on the complete points below fitted_on_points_below)."""
+    and "corners_held_out" (the corner batch, fitted on the complete points below fitted_on_points_below); the name
+    is the check's key in surrogate.json and its table's file name."""
     checks = []
     if study.get("held_out"):
         first = study["held_out"]["from_batch"] * study["batch_points"]
@@ -46,7 +47,7 @@ def held_out_checks(study, records, rows, responses, scatter, permutations=2000,
     if study.get("corners"):
         below = study["corners"]["fitted_on_points_below"]
         corners = set(corner_points(study, records))
-        checks.append(("corners", held_out_check(study, records, rows, responses, scatter, permutations, top,
+        checks.append(("corners_held_out", held_out_check(study, records, rows, responses, scatter, permutations, top,
                                                  lambda p: p < below and p not in corners, sorted(corners))))
     return checks
 
