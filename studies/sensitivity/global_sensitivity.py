@@ -317,10 +317,10 @@ def main(argv):
         if args.batch is not None and args.batch < 0:
             raise StudyError("--batch must be at least 0")
         if not args.analyze_only:
-            for b in ([args.batch] if args.batch is not None else range(args.batches)):
+            batches = [args.batch] if args.batch is not None else list(range(args.batches))
+            for b in batches:
                 for replica in replica_names(study):
-                    last = args.batch if args.batch is not None else args.batches - 1
-                    path = write_batch(study, args.out, b, replica, args.points if args.points and b == last else None)
+                    path = write_batch(study, args.out, b, replica, args.points if args.points and b == batches[-1] else None)
                     if not args.design_only:
                         if not os.access(args.needle, os.X_OK):
                             raise StudyError(f"{args.needle}: no needle command (build it: bash scripts/build.sh needle)")

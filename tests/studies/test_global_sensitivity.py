@@ -336,19 +336,25 @@ with tempfile.TemporaryDirectory() as tmp:
 # from the design, before any of them has run; as they run, the observed means are set beside. On the known smooth
 # function the predictions hold (validated, errors within the sd); where batch 1's runs are offset by 0.3 (the model
 # not what batch 0 showed), the check fails. The linear trend (kriging_trend) follows a ratio linear in a factor.
+def write_truth_records(design, folder, batch, points_limit=None, offset=0.0):
+    """A batch's sweep file and the known function's case records, as `needle sweep` writes them; offset shifts every
+    multi-bevel needle's ratio to SB (the model not what the fitted points showed)."""
+    gs.write_batch(design, folder, batch, "", points_limit)
+    for index, (point, needle_name, values) in enumerate(gs.batch_cases(design, batch, points_limit)):
+        case_dir = os.path.join(folder, f"batch_{batch}", "sweep", "cases", f"case_{index:04d}")
+        os.makedirs(case_dir, exist_ok=True)
+        deflection, _ = truth(values)
+        value = deflection[needle_name] + (offset * deflection["SB"] if needle_name != "SB" else 0.0)  # the ratio + offset
+        with open(os.path.join(case_dir, "case.json"), "w") as f:
+            json.dump({"label": f"point {point:03d} {needle_name}", "status": "finished", "deflection_mm": value,
+                       "groove_fill": 0.9, "runtime_s": 1.0}, f)
+
+
 with tempfile.TemporaryDirectory() as tmp:
     held = dict(study, batch_points=24, kriging_trend="linear", held_out={"from_batch": 1})
 
     def write_records(batch, points_limit=None, offset=0.0):
-        gs.write_batch(held, tmp, batch, "", points_limit)
-        for index, (point, needle_name, values) in enumerate(gs.batch_cases(held, batch, points_limit)):
-            case_dir = os.path.join(tmp, f"batch_{batch}", "sweep", "cases", f"case_{index:04d}")
-            os.makedirs(case_dir, exist_ok=True)
-            deflection, _ = truth(values)
-            value = deflection[needle_name] + (offset * deflection["SB"] if needle_name != "SB" else 0.0)  # the ratio + offset
-            with open(os.path.join(case_dir, "case.json"), "w") as f:
-                json.dump({"label": f"point {point:03d} {needle_name}", "status": "finished", "deflection_mm": value,
-                           "groove_fill": 0.9, "runtime_s": 1.0}, f)
+        write_truth_records(held, tmp, batch, points_limit, offset)
 
     write_records(0)
     gs.write_batch(held, tmp, 1, "", 8)
@@ -397,19 +403,11 @@ check(corner_cases[0][0] == 48 and len(corner_cases) == 8 * len(half["needles"])
 check(gs.batch_cases(half, 1) == gs.batch_cases(dict(half, corners=None), 1), "the Sobol' batches are not moved by the corners")
 
 with tempfile.TemporaryDirectory() as tmp:
-    def write_corner_records(batch, points_limit=None, offset=0.0):
-        gs.write_batch(half, tmp, batch, "", points_limit)
-        for k, (point, needle_name, values) in enumerate(gs.batch_cases(half, batch, points_limit)):
-            case_dir = os.path.join(tmp, f"batch_{batch}", "sweep", "cases", f"case_{k:04d}")
-            os.makedirs(case_dir, exist_ok=True)
-            deflection, _ = truth(values)
-            value = deflection[needle_name] + (offset * deflection["SB"] if needle_name != "SB" else 0.0)
-            with open(os.path.join(case_dir, "case.json"), "w") as f:
-                json.dump({"label": f"point {point:03d} {needle_name}", "status": "finished", "deflection_mm": value,
-                           "groove_fill": 0.9, "runtime_s": 1.0}, f)
+    half = dict(half, kriging_trend="linear", held_out={"from_batch": 1})
 
-    linear = dict(half, kriging_trend="linear", held_out={"from_batch": 1})
-    half = linear
+    def write_corner_records(batch, points_limit=None, offset=0.0):
+        write_truth_records(half, tmp, batch, points_limit, offset)
+
     write_corner_records(0)
     write_corner_records(1, 12)
     gs.write_batch(half, tmp, 2)
@@ -421,7 +419,7 @@ with tempfile.TemporaryDirectory() as tmp:
     check(before["held_out"]["points"] == list(range(24, 48)), "batch 1's check leaves the corners to their own")
     with open(os.path.join(tmp, "analysis", "corners_held_out.csv")) as f:
         predicted_before = [line.split(",")[-9:] for line in f.read().splitlines()[1:]]
-    write_corner_records(1)  # more of batch 1 (points 36-47): below the corners' fit set's bound? no: they stay out of it
+    write_corner_records(1)  # the rest of batch 1 (points 36-47): at or above the bound, so outside the corners' fit
     write_corner_records(2)
     after = gs.analyze(half, tmp, permutations=200)
     with open(os.path.join(tmp, "analysis", "corners_held_out.csv")) as f:
