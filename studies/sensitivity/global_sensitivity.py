@@ -21,7 +21,9 @@ A study file's "kriging_trend" ("constant", the default, or "linear") is the sur
 {"from_batch": K} adds the held-out check (study_held_out.py): the procedure fitted on batches 0..K-1 predicts the
 points of batch K on, from the design, before they run (analysis/held_out.csv), and is judged on them as they complete.
 Its "corners" make one batch the box's corners in the named factors (study_design.read_corners), predicted the same way
-from the points below "fitted_on_points_below" (analysis/corners_held_out.csv) and then part of the fit.
+from the points below "fitted_on_points_below" (analysis/corners_held_out.csv) and then part of the fit. Its
+"points_held_out": {"points": [a, b]} predicts the points a..b-1 from every other complete point
+(analysis/points_held_out.csv): a held-out round for the surrogates as refitted after the earlier checks.
 
 Writes into --out: batch_K/sweep.json (the sweep file of batch K) and batch_K/sweep/ (its sweep folder), the same in
 batch_K_NAME/ for each replica NAME, and
@@ -39,8 +41,8 @@ import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from study_design import (StudyError, batch_cases, batch_folder, corner_units, factor_value, numeric, read_study, replica_names,  # noqa: E402,F401
-                          replica_set, sweep_file, unit_design, write_batch, write_sweep_file)
+from study_design import (StudyError, batch_cases, batch_folder, corner_units, factor_value, numeric, read_points_held_out, read_study,  # noqa: E402,F401
+                          replica_names, replica_set, sweep_file, unit_design, write_batch, write_sweep_file)
 from study_runs import (MEASURED_MM, PLATEAU, POOLED_SD_MM, case_records, complete_rows, point_runs, read_points,  # noqa: E402,F401
                         replica_scatter, response_view, responses, within_point_scatter)
 from study_held_out import held_out_checks, write_held_out  # noqa: E402

@@ -40,6 +40,7 @@ def read_study(path):
     if study.get("kriging_trend", "constant") not in ("constant", "linear"):
         raise StudyError(f"{path}: 'kriging_trend' must be \"constant\" or \"linear\"")
     read_corners(study, path)
+    read_points_held_out(study, path)
     held = study.get("held_out")
     if held is not None and not (isinstance(held, dict) and isinstance(held.get("from_batch"), int) and held["from_batch"] >= 1):
         raise StudyError(f"{path}: 'held_out' needs a 'from_batch' of at least 1 (the surrogates are fitted on the batches before it)")
@@ -93,6 +94,19 @@ def read_corners(study, path):
     if not (isinstance(below, int) and not isinstance(below, bool) and 4 <= below <= batch * study["batch_points"]):
         raise StudyError(f"{path}: 'corners' needs 'fitted_on_points_below': the points the predictions are fitted on "
                          f"(at least 4, at most the {batch * study['batch_points']} points of the batches before it)")
+
+
+def read_points_held_out(study, path):
+    """A study file's "points_held_out": {"points": [a, b]}: the design points a..b-1 are predicted by the analysis's
+    procedure fitted on every other complete point, before they run (study_held_out.py), a second held-out round for
+    surrogates that were refitted after the first."""
+    held = study.get("points_held_out")
+    if held is None:
+        return
+    points = held.get("points") if isinstance(held, dict) else None
+    if not (isinstance(points, list) and len(points) == 2 and all(isinstance(p, int) and not isinstance(p, bool) for p in points)
+            and 0 <= points[0] < points[1]):
+        raise StudyError(f"{path}: 'points_held_out' needs 'points': [a, b], the design points a..b-1 it predicts (0 <= a < b)")
 
 
 def corner_units(study, corners=None):

@@ -1,5 +1,7 @@
-"""The held-out checks of a study's surrogates: a study file's "held_out": {"from_batch": K}, and its "corners"
-(study_design.read_corners: the box's corners, predicted from the points below "fitted_on_points_below").
+"""The held-out checks of a study's surrogates: a study file's "held_out": {"from_batch": K}, its "corners"
+(study_design.read_corners: the box's corners, predicted from the points below "fitted_on_points_below") and its
+"points_held_out": {"points": [a, b]} (the points a..b-1, predicted from every other complete point: a round for the
+surrogates as refitted after the earlier checks).
 
 A surrogate's leave-one-out Q2 is computed on the points its form was chosen on. The held-out check asks the harder
 question: the analysis's own procedure (each response's HSIC screen, its most influential factors, the kriging with the
@@ -36,9 +38,10 @@ def held_out_points(study, records):
 
 
 def held_out_checks(study, records, rows, responses, scatter, permutations=2000, top=3):
-    """Each held-out check the study declares: [(name, check)], "held_out" (batch K on, fitted on the batches before)
-    and "corners_held_out" (the corner batch, fitted on the complete points below fitted_on_points_below); the name
-    is the check's key in surrogate.json and its table's file name."""
+    """Each held-out check the study declares: [(name, check)], "held_out" (batch K on, fitted on the batches before),
+    "corners_held_out" (the corner batch, fitted on the complete points below fitted_on_points_below) and
+    "points_held_out" (points a..b-1, fitted on every other complete point); the name is the check's key in
+    surrogate.json and its table's file name."""
     checks = []
     if study.get("held_out"):
         first = study["held_out"]["from_batch"] * study["batch_points"]
@@ -49,6 +52,10 @@ def held_out_checks(study, records, rows, responses, scatter, permutations=2000,
         corners = set(corner_points(study, records))
         checks.append(("corners_held_out", held_out_check(study, records, rows, responses, scatter, permutations, top,
                                                  lambda p: p < below and p not in corners, sorted(corners))))
+    if study.get("points_held_out"):
+        first, end = study["points_held_out"]["points"]
+        checks.append(("points_held_out", held_out_check(study, records, rows, responses, scatter, permutations, top,
+                                                lambda p: not first <= p < end, [p for p in sorted(records) if first <= p < end])))
     return checks
 
 
@@ -117,7 +124,8 @@ def held_out_check(study, records, rows, responses, scatter, permutations, top, 
 
 def write_held_out(folder, check, study, responses, name="held_out"):
     """NAME.csv (one row a held-out point: its factors, each response's prediction, sd and observed mean) and the
-    Markdown lines of the check ("held_out": batch K on; "corners": the corner batch)."""
+    Markdown lines of the check ("held_out": batch K on; "corners_held_out": the corner batch; "points_held_out": the
+    points a..b-1)."""
     columns = ["point"] + [f["name"] for f in study["factors"]] + ["runs"] + [
         f"{r}_{k}" for r in responses for k in ("predicted", "sd", "observed")]
     path = os.path.join(folder, f"{name}.csv")
@@ -132,6 +140,10 @@ def write_held_out(folder, check, study, responses, name="held_out"):
         md = [f"## Held out: the surrogates fitted on the {check['fitted_points']} complete points below point {c['fitted_on_points_below']} "
               f"predict the {len(check['points'])} corners of batch {c['batch']} ({'half of ' if c.get('half_fraction') else ''}"
               f"the box's corners in {', '.join(c['factors'])}; the other factors at their middle)", ""]
+    elif name == "points_held_out":
+        first, end = study["points_held_out"]["points"]
+        md = [f"## Held out: the surrogates fitted on every other complete point ({check['fitted_points']} points) predict "
+              f"points {first}..{end - 1} ({len(check['points'])} in the design so far)", ""]
     else:
         first = study["held_out"]["from_batch"]
         md = [f"## Held out: the surrogates fitted on batches 0..{first - 1} ({check['fitted_points']} points) predict the "

@@ -435,6 +435,47 @@ with tempfile.TemporaryDirectory() as tmp:
     check(not off["ratio_AMB"]["validated"] and abs(off["ratio_AMB"]["bias"] - 0.6) < 0.02,
           f"the corners offset by 0.6: their check fails (AMB's mean error {off['ratio_AMB']['bias']:+.3f}, Q2 {off['ratio_AMB']['q2']:.2f})")
 
+# A second held-out round ("points_held_out": {"points": [36, 44]}): the surrogates refitted on every complete point
+# outside 36..43 (batch 0, batch 1's first 12 and the corners: 44) predict batch 1's next 8 points before they run; their
+# runs do not move the predictions (the fit leaves them out), the known function's points hold, and batch 1's runs
+# offset by 0.3 (its 12 fitted points too, so the fit moves by part of it) fail the check.
+with tempfile.TemporaryDirectory() as tmp:
+    later = dict(half, kriging_trend="linear", held_out={"from_batch": 1}, points_held_out={"points": [36, 44]})
+
+    def write_later_records(batch, points_limit=None, offset=0.0):
+        write_truth_records(later, tmp, batch, points_limit, offset)
+
+    write_later_records(0)
+    write_later_records(1, 12)
+    write_later_records(2)
+    gs.write_batch(later, tmp, 1, "", 20)
+    before = gs.analyze(later, tmp, permutations=200)["points_held_out"]
+    check(before["fitted_points"] == 44 and before["points"] == list(range(36, 44))
+          and before["responses"]["ratio_AMB"]["observed_points"] == 0,
+          f"points 36..43 are predicted from the 44 other complete points before they run ({before['fitted_points']})")
+    with open(os.path.join(tmp, "analysis", "points_held_out.csv")) as f:
+        predicted_before = [[cell for i, cell in enumerate(line.split(",")[-9:]) if i % 3 != 2] for line in f.read().splitlines()[1:]]
+    write_later_records(1, 20)
+    after = gs.analyze(later, tmp, permutations=200)
+    with open(os.path.join(tmp, "analysis", "points_held_out.csv")) as f:
+        predicted_after = [[cell for i, cell in enumerate(line.split(",")[-9:]) if i % 3 != 2] for line in f.read().splitlines()[1:]]
+    check(predicted_after == predicted_before, "the held-out points' runs do not move their predictions")
+    ok = after["points_held_out"]["responses"]
+    check(all(ok[r]["observed_points"] == 8 and ok[r]["validated"] for r in ("ratio_LMB", "ratio_AMB")),
+          "on the known function the refitted surrogates' predictions hold (RMSE LMB {:.4f}, AMB {:.4f})".format(ok["ratio_LMB"]["rmse"], ok["ratio_AMB"]["rmse"]))
+    check(after["points_complete"] == 52 and after["corners_held_out"]["fitted_points"] == 36,
+          f"the points then join the fit, and the corners' own check is not moved ({after['points_complete']} points)")
+    write_later_records(1, 20, offset=0.3)
+    off = gs.analyze(later, tmp, permutations=200)["points_held_out"]["responses"]
+    check(not off["ratio_AMB"]["validated"] and not off["ratio_LMB"]["validated"],
+          f"batch 1 offset by 0.3: the check fails (AMB's mean error {off['ratio_AMB']['bias']:+.3f}, Q2 {off['ratio_AMB']['q2']:.2f})")
+    for held, words in (({"points": [44, 36]}, "0 <= a < b"), ({"points": 36}, "'points': [a, b]"), ([36, 44], "'points': [a, b]")):
+        try:
+            gs.read_points_held_out({"points_held_out": held}, "study.json")
+            check(False, f"a bad 'points_held_out' is refused ({held})")
+        except gs.StudyError as e:
+            check(words in str(e), f"a bad 'points_held_out' is refused ({e})")
+
 # One more parameter fitted honestly (second_parameter.py): ratios linear in the value, so every fit has a closed form.
 import second_parameter as sp  # noqa: E402
 
