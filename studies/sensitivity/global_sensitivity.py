@@ -201,7 +201,7 @@ def analyze(study, out, permutations=2000, top=3, root=None):
               "replica_sd": scatter, "report_replica_sd": report_scatter,
               "within_point_sd": {r: {"sd": v[0], "dof": v[1]} for r, v in within.items()}, "surrogates": surrogates, "chaos": chaos, "joint": joint, "nearest_run_point": nearest, "measured_mm": MEASURED_MM}
     checks = held_out_checks(study, records, rows, fitted, scatter, permutations, top)
-    for name, check in checks:
+    for name, _, check in checks:
         result[name] = {k: v for k, v in check.items() if k != "rows"}
     with open(os.path.join(folder, "surrogate.json.tmp"), "w") as f:
         json.dump(result, f, indent=1)
@@ -279,8 +279,8 @@ def analyze(study, out, permutations=2000, top=3, root=None):
                   f"{MEASURED_MM['AMB'] - MEASURED_MM['LMB']:+.2f} +- 0.05 mm)")
     md.append(f"- two standard deviations of the experiment: {2 * POOLED_SD_MM:.2f} mm")
     md.append("")
-    for name, check in checks:
-        md.extend(write_held_out(folder, check, study, fitted, name))
+    for name, heading, check in checks:
+        md.extend(write_held_out(folder, name, heading, check, study, fitted))
     with open(os.path.join(folder, "hsic.md"), "w") as f:
         f.write("\n".join(md))
     plot_hsic(os.path.join(folder, "hsic.png"), study, table, resp)

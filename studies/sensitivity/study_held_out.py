@@ -38,24 +38,34 @@ def held_out_points(study, records):
 
 
 def held_out_checks(study, records, rows, responses, scatter, permutations=2000, top=3):
-    """Each held-out check the study declares: [(name, check)], "held_out" (batch K on, fitted on the batches before),
-    "corners_held_out" (the corner batch, fitted on the complete points below fitted_on_points_below) and
+    """Each held-out check the study declares: [(name, heading, check)], "held_out" (batch K on, fitted on the batches
+    before), "corners_held_out" (the corner batch, fitted on the complete points below fitted_on_points_below) and
     "points_held_out" (points a..b-1, fitted on every other complete point); the name is the check's key in
-    surrogate.json and its table's file name."""
+    surrogate.json and its table's file name, the heading its section's in hsic.md, each written where the check is
+    declared."""
+    def check(fitted, points):
+        return held_out_check(study, records, rows, responses, scatter, permutations, top, fitted, points)
+
     checks = []
     if study.get("held_out"):
-        first = study["held_out"]["from_batch"] * study["batch_points"]
-        checks.append(("held_out", held_out_check(study, records, rows, responses, scatter, permutations, top,
-                                                  lambda p: p < first, held_out_points(study, records))))
+        batch = study["held_out"]["from_batch"]
+        first = batch * study["batch_points"]
+        c = check(lambda p: p < first, held_out_points(study, records))
+        checks.append(("held_out", f"the surrogates fitted on batches 0..{batch - 1} ({c['fitted_points']} points) predict the "
+                                   f"{len(c['points'])} points of batch {batch} on (the corners apart)", c))
     if study.get("corners"):
-        below = study["corners"]["fitted_on_points_below"]
+        spec = study["corners"]
+        below = spec["fitted_on_points_below"]
         corners = set(corner_points(study, records))
-        checks.append(("corners_held_out", held_out_check(study, records, rows, responses, scatter, permutations, top,
-                                                 lambda p: p < below and p not in corners, sorted(corners))))
+        c = check(lambda p: p < below and p not in corners, sorted(corners))
+        checks.append(("corners_held_out", f"the surrogates fitted on the {c['fitted_points']} complete points below point {below} "
+                                           f"predict the {len(c['points'])} corners of batch {spec['batch']} ({'half of ' if spec.get('half_fraction') else ''}"
+                                           f"the box's corners in {', '.join(spec['factors'])}; the other factors at their middle)", c))
     if study.get("points_held_out"):
         first, end = study["points_held_out"]["points"]
-        checks.append(("points_held_out", held_out_check(study, records, rows, responses, scatter, permutations, top,
-                                                lambda p: not first <= p < end, [p for p in sorted(records) if first <= p < end])))
+        c = check(lambda p: not first <= p < end, [p for p in sorted(records) if first <= p < end])
+        checks.append(("points_held_out", f"the surrogates fitted on every other complete point ({c['fitted_points']} points) predict "
+                                          f"points {first}..{end - 1} ({len(c['points'])} in the design so far)", c))
     return checks
 
 
@@ -122,10 +132,9 @@ def held_out_check(study, records, rows, responses, scatter, permutations, top, 
     return {"fitted_points": len(fit_rows), "top": top, "points": points, "responses": summary, "rows": table}
 
 
-def write_held_out(folder, check, study, responses, name="held_out"):
+def write_held_out(folder, name, heading, check, study, responses):
     """NAME.csv (one row a held-out point: its factors, each response's prediction, sd and observed mean) and the
-    Markdown lines of the check ("held_out": batch K on; "corners_held_out": the corner batch; "points_held_out": the
-    points a..b-1)."""
+    Markdown lines of the check under its heading (held_out_checks)."""
     columns = ["point"] + [f["name"] for f in study["factors"]] + ["runs"] + [
         f"{r}_{k}" for r in responses for k in ("predicted", "sd", "observed")]
     path = os.path.join(folder, f"{name}.csv")
@@ -135,19 +144,7 @@ def write_held_out(folder, check, study, responses, name="held_out"):
         for row in check["rows"]:
             w.writerow(["" if row.get(c) is None else (f"{row[c]:.6g}" if isinstance(row[c], float) else row[c]) for c in columns])
     os.replace(path + ".tmp", path)
-    if name == "corners_held_out":
-        c = study["corners"]
-        md = [f"## Held out: the surrogates fitted on the {check['fitted_points']} complete points below point {c['fitted_on_points_below']} "
-              f"predict the {len(check['points'])} corners of batch {c['batch']} ({'half of ' if c.get('half_fraction') else ''}"
-              f"the box's corners in {', '.join(c['factors'])}; the other factors at their middle)", ""]
-    elif name == "points_held_out":
-        first, end = study["points_held_out"]["points"]
-        md = [f"## Held out: the surrogates fitted on every other complete point ({check['fitted_points']} points) predict "
-              f"points {first}..{end - 1} ({len(check['points'])} in the design so far)", ""]
-    else:
-        first = study["held_out"]["from_batch"]
-        md = [f"## Held out: the surrogates fitted on batches 0..{first - 1} ({check['fitted_points']} points) predict the "
-              f"{len(check['points'])} points of batch {first} on (the corners apart)", ""]
+    md = [f"## Held out: {heading}", ""]
     md += [
           f"Each response's procedure as above (its {check['top']} most influential factors by HSIC, "
           f"the kriging with a {study.get('kriging_trend', 'constant')} trend and the runs' noise), fitted without the held-out points; "

@@ -350,6 +350,13 @@ def write_truth_records(design, folder, batch, points_limit=None, offset=0.0):
                        "groove_fill": 0.9, "runtime_s": 1.0}, f)
 
 
+def stored_predictions(folder, name):
+    """Each point's predictions and their sd in analysis/NAME.csv (its last nine columns: three responses' predicted,
+    sd, observed), the observed left out: what must not move when the held-out points run."""
+    with open(os.path.join(folder, "analysis", f"{name}.csv")) as f:
+        return [[cell for i, cell in enumerate(line.split(",")[-9:]) if i % 3 != 2] for line in f.read().splitlines()[1:]]
+
+
 with tempfile.TemporaryDirectory() as tmp:
     held = dict(study, batch_points=24, kriging_trend="linear", held_out={"from_batch": 1})
 
@@ -417,14 +424,11 @@ with tempfile.TemporaryDirectory() as tmp:
           and corners_before["responses"]["ratio_AMB"]["observed_points"] == 0,
           "the corners are predicted from the 36 points below 36 before they run")
     check(before["held_out"]["points"] == list(range(24, 48)), "batch 1's check leaves the corners to their own")
-    with open(os.path.join(tmp, "analysis", "corners_held_out.csv")) as f:
-        predicted_before = [line.split(",")[-9:] for line in f.read().splitlines()[1:]]
+    predicted_before = stored_predictions(tmp, "corners_held_out")
     write_corner_records(1)  # the rest of batch 1 (points 36-47): at or above the bound, so outside the corners' fit
     write_corner_records(2)
     after = gs.analyze(half, tmp, permutations=200)
-    with open(os.path.join(tmp, "analysis", "corners_held_out.csv")) as f:
-        predicted_after = [[cell for i, cell in enumerate(line.split(",")[-9:]) if i % 3 != 2] for line in f.read().splitlines()[1:]]
-    check(predicted_after == [[cell for i, cell in enumerate(row) if i % 3 != 2] for row in predicted_before],
+    check(stored_predictions(tmp, "corners_held_out") == predicted_before,
           "neither the corners' runs nor batch 1's later points move the corners' predictions")
     ok = after["corners_held_out"]["responses"]
     check(all(ok[r]["observed_points"] == 8 and ok[r]["validated"] for r in ("ratio_LMB", "ratio_AMB")),
@@ -440,7 +444,7 @@ with tempfile.TemporaryDirectory() as tmp:
 # runs do not move the predictions (the fit leaves them out), the known function's points hold, and batch 1's runs
 # offset by 0.3 (its 12 fitted points too, so the fit moves by part of it) fail the check.
 with tempfile.TemporaryDirectory() as tmp:
-    later = dict(half, kriging_trend="linear", held_out={"from_batch": 1}, points_held_out={"points": [36, 44]})
+    later = dict(half, points_held_out={"points": [36, 44]})  # half: the linear trend and batch 1 held out, as above
 
     def write_later_records(batch, points_limit=None, offset=0.0):
         write_truth_records(later, tmp, batch, points_limit, offset)
@@ -453,13 +457,10 @@ with tempfile.TemporaryDirectory() as tmp:
     check(before["fitted_points"] == 44 and before["points"] == list(range(36, 44))
           and before["responses"]["ratio_AMB"]["observed_points"] == 0,
           f"points 36..43 are predicted from the 44 other complete points before they run ({before['fitted_points']})")
-    with open(os.path.join(tmp, "analysis", "points_held_out.csv")) as f:
-        predicted_before = [[cell for i, cell in enumerate(line.split(",")[-9:]) if i % 3 != 2] for line in f.read().splitlines()[1:]]
+    predicted_before = stored_predictions(tmp, "points_held_out")
     write_later_records(1, 20)
     after = gs.analyze(later, tmp, permutations=200)
-    with open(os.path.join(tmp, "analysis", "points_held_out.csv")) as f:
-        predicted_after = [[cell for i, cell in enumerate(line.split(",")[-9:]) if i % 3 != 2] for line in f.read().splitlines()[1:]]
-    check(predicted_after == predicted_before, "the held-out points' runs do not move their predictions")
+    check(stored_predictions(tmp, "points_held_out") == predicted_before, "the held-out points' runs do not move their predictions")
     ok = after["points_held_out"]["responses"]
     check(all(ok[r]["observed_points"] == 8 and ok[r]["validated"] for r in ("ratio_LMB", "ratio_AMB")),
           "on the known function the refitted surrogates' predictions hold (RMSE LMB {:.4f}, AMB {:.4f})".format(ok["ratio_LMB"]["rmse"], ok["ratio_AMB"]["rmse"]))
