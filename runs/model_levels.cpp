@@ -18,7 +18,7 @@ const std::vector<ModelLevel>& model_levels() {
       {"projection", "fe", "projection", false, SupportShape::sphere, 0, "explicit FE needle, kinematic contact: the tissue's own step",
        "calibration_sb_full.json"},
       {"fast", "implicit", "projection", true, SupportShape::ellipsoid, 3,
-       "implicit linear needle at the coupling step, kinematic contact, tissue mass-scaled where its step is short (to a quarter of the needle's step): no subcycling; "
+       "implicit linear needle at the coupling step, kinematic contact, tissue mass-scaled where its step is short (to half the needle's step): no subcycling; "
        "ellipsoidal kernel supports on the graded lattice; the tissue away from the needle at up to 8 coupling steps (multi-rate)",
        "calibration_sb.json"},
   };

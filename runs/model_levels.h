@@ -3,7 +3,7 @@
 // `needle bench`) can ask for "the fast model" or "the full model" without knowing the scene keys:
 //   full        the FE needle (explicit, subcycled) and the penalty contact: the reference, the paper's kind of model;
 //   projection  the FE needle and the kinematic contact: the contact no longer sets the step (one lever);
-//   fast        the implicit needle, the kinematic contact and the tissue mass-scaled to a quarter of the needle's step: no
+//   fast        the implicit needle, the kinematic contact and the tissue mass-scaled to half the needle's step: no
 //               subcycling, and the few particles squeezed under the tip no longer set everybody's step;
 //               ellipsoidal kernel supports, so the graded lattice's coarse particles reach as many neighbours as
 //               the fine ones (solver/tissue/kernel_supports.h); and the tissue away from the needle stepped at up to

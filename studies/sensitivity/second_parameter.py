@@ -14,7 +14,7 @@ SB leaves as the prediction, delta_X ~ -1.14 mm x ratio_X):
 A key that is a depth into the lip below tip point A (`--lip-depth`, e.g. tissue.separation.lip.depth_mm;
 its older spelling tissue.contact.lip_release_depth_mm, which the stored records use, is read the same) acts on a
 needle only below that needle's lip thickness: each needle then runs at its own values (`--needle-values HMB=0.2,0.4
-AMB=0.1,0.3`) and once with the key unset (the whole lip), and that run stands for it at every value from its lip
+AMB=0.1,0.3`) and once with the whole lip crushed (the key set to "whole lip"; the label's value is `default`), and that run stands for it at every value from its lip
 thickness (the run's summary.json, lip_release.lip_thickness_mm) on; a needle with no values of its own (SB, no lip)
 runs only unset. Between its last value and its lip thickness a needle is interpolated towards the unset run.
 
@@ -36,6 +36,7 @@ MULTI = ["LMB", "AMB", "HMB"]
 
 
 DEFAULT = "default"  # the label's value of a case with the key unset (--lip-depth)
+WHOLE_LIP = "whole lip"  # a depth key's value for the whole lip (solver/separation/lip_release.h, kWholeLipText)
 
 
 def sweep_file(key, values, travel_mm, needle_values=None, lip_depth=False):
@@ -51,9 +52,9 @@ def sweep_file(key, values, travel_mm, needle_values=None, lip_depth=False):
         for n in NEEDLES:
             for v in per_needle.get(n, []):
                 cases.append({"label": f"{key}={v:g} {n}", "needle.preset": n, key: v})
-    if lip_depth:
+    if lip_depth:  # the whole lip said outright: since 2026-11-28 a scene's default crushes 0.45 mm of it
         for n in NEEDLES:
-            cases.append({"label": f"{key}={DEFAULT} {n}", "needle.preset": n})
+            cases.append({"label": f"{key}={DEFAULT} {n}", "needle.preset": n, key: WHOLE_LIP})
     return {"model": "fast", "set": {"motion.travel_mm": travel_mm, "output.frames": 0}, "design": {"cases": cases}}
 
 

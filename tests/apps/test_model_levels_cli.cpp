@@ -26,15 +26,15 @@ TEST_CASE("needle run --model fast runs the implicit needle with the kinematic c
   CHECK(fast.summary["particles_inside"].get<int>() == 0);
   // One needle step or a few per coupling step, where the explicit needle takes hundreds.
   CHECK(fast.summary["needle_steps"].get<long>() < 4 * fast.summary["steps"].get<long>());
-  // The tissue mass-scaled to a quarter of the needle's step: the scene says so, the summary gives the target and what was added.
+  // The tissue mass-scaled to half the needle's step: the scene says so, the summary gives the target and what was added.
   CHECK(fast.scene["solver"]["tissue_mass_scaling"] == true);
   REQUIRE(fast.summary.contains("tissue_mass_scaling"));
-  CHECK(fast.summary["tissue_mass_scaling"]["target_dt_ms"].get<double>() == Approx(0.25 * fast.summary["needle_time_step_ms"].get<double>()));
-  // This small block's particles need no mass at a quarter of the needle's step; at twice the needle's step the
+  CHECK(fast.summary["tissue_mass_scaling"]["target_dt_ms"].get<double>() == Approx(0.5 * fast.summary["needle_time_step_ms"].get<double>()));
+  // This small block's particles need no mass at half the needle's step; at twice the needle's step the
   // squeezed ones do, a bounded share of the block's, and the kinetic energy the mass changes take out is a small part of
   // what the drive put in.
-  const nlohmann::json& quarter = fast.summary["tissue_mass_scaling"];
-  CHECK((quarter["max_mass_ratio"].get<double>() > 1.0) == (quarter["max_added_mass_percent"].get<double>() > 0.0));
+  const nlohmann::json& half = fast.summary["tissue_mass_scaling"];
+  CHECK((half["max_mass_ratio"].get<double>() > 1.0) == (half["max_added_mass_percent"].get<double>() > 0.0));
   const RunFiles coarse = run_sb_into_small_block(
       "model_fast_coarse", fmt::format("--model fast --set solver.tissue_mass_scaling_dt_ms={}", 2 * fast.summary["needle_time_step_ms"].get<double>()));
   const nlohmann::json& scaling = coarse.summary["tissue_mass_scaling"];

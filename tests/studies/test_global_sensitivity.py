@@ -532,6 +532,10 @@ with tempfile.TemporaryDirectory() as tmp:
     path = os.path.join(tmp, "sweep.json")
     with open(path, "w") as f:
         json.dump(sp.sweep_file("tissue.contact.lip_release_depth_mm", [], 30.0, {"HMB": [0.2, 0.4], "AMB": [0.1]}, True), f)
+    unset_cases = [c for c in sp.sweep_file("tissue.contact.lip_release_depth_mm", [], 30.0, {"HMB": [0.2]}, True)["design"]["cases"]
+                   if c["label"].endswith(" HMB") and sp.DEFAULT in c["label"]]
+    check(len(unset_cases) == 1 and unset_cases[0]["tissue.contact.lip_release_depth_mm"] == "whole lip",
+          "lip depth: the run standing for the whole lip says so, not the scene's default depth")
     count = subprocess.run([needle, "sweep", path, "--count"], capture_output=True, text=True)
     check(count.returncode == 0 and count.stdout.strip() == "7",
           f"lip depth: each needle's own values and the four unset runs pass needle sweep --count ({count.stdout.strip()})")
