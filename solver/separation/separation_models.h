@@ -24,7 +24,7 @@ struct SeparationOptions {
                             // false: only the tissue's failure criterion separates particles
   SymmetrySlitOptions slit;  // the tissue also opens in the symmetry plane behind the tip; off by default
   TipCrackOptions crack;     // the tip drives a crack past the rod's outline; off by default
-  LipReleaseOptions lip;     // the lip below tip point A crushed or cut loose; off here, crushed 0.45 mm deep in a scene
+  LipReleaseOptions lip;     // the lip below tip point A crushed or cut loose; off here, crushed kSceneCrushedLipDepthMm deep in a scene
   void validate(const std::string& where = "separation") const;  // InputError naming the bad field
 };
 
@@ -33,7 +33,7 @@ struct SeparationOptions {
 // fit; the others are predicted (docs/notebook/crushed_depth.md; the fit's record, with its leave-one-needle-out
 // errors, is data/paper/crushed_depth_hmb.json, and the paper report names it). A lip thinner than this (SB, LMB, AMB)
 // is crushed whole.
-constexpr double kSceneCrushedLipDepthMm = 0.45;
+constexpr double kSceneCrushedLipDepthMm = 0.48;
 
 // A scene's defaults: SeparationOptions{} with the lip below the tip point crushed to kSceneCrushedLipDepthMm
 // (lip_release.h).

@@ -52,7 +52,7 @@ def sweep_file(key, values, travel_mm, needle_values=None, lip_depth=False):
         for n in NEEDLES:
             for v in per_needle.get(n, []):
                 cases.append({"label": f"{key}={v:g} {n}", "needle.preset": n, key: v})
-    if lip_depth:  # the whole lip said outright: since 2026-11-28 a scene's default crushes 0.45 mm of it
+    if lip_depth:  # the whole lip said outright: since 2026-11-28 a scene's default crushes only its top
         for n in NEEDLES:
             cases.append({"label": f"{key}={DEFAULT} {n}", "needle.preset": n, key: WHOLE_LIP})
     return {"model": "fast", "set": {"motion.travel_mm": travel_mm, "output.frames": 0}, "design": {"cases": cases}}

@@ -383,7 +383,7 @@ TEST_CASE("needle run --tissue-entry-x-mm: the block starts there, the rod meets
   }
 }
 
-TEST_CASE("tissue.separation.lip.mode: crushed 0.45 mm deep by default, the whole lip, free or off on request, SB has no lip, bad input is refused",
+TEST_CASE("tissue.separation.lip.mode: crushed to the scene depth by default, the whole lip, free or off on request, SB has no lip, bad input is refused",
           "[apps][lspg][gmsh][lip][slow]") {
   // HMB's tip point sits 0.80 mm above the rod's bottom: pushed 0.8 mm into the small block (0.4 mm particles), the particles
   // the tip passes below A inside the rod's outline are crushed by default (bonds kept), cut loose when free (every bond
@@ -411,7 +411,7 @@ TEST_CASE("tissue.separation.lip.mode: crushed 0.45 mm deep by default, the whol
   CHECK(crushed.summary["lip_release"]["bonds_cut"].get<long>() == 0);
   CHECK(crushed.summary["lip_release"]["depth_mm"].get<double>() == needle::kSceneCrushedLipDepthMm);
   CHECK(whole.summary["lip_release"]["depth_mm"] == "whole lip");
-  // HMB's lip is 0.80 mm: the whole lip holds more particles than its top 0.45 mm.
+  // HMB's lip is 0.80 mm: the whole lip holds more particles than its top (the scene's depth, 0.48 mm).
   CHECK(whole.summary["lip_release"]["particles_released"].get<long>() > crushed.summary["lip_release"]["particles_released"].get<long>());
   CHECK(free_band.summary["lip_release"]["bonds_cut"].get<long>() > 0);
   CHECK(free_band.summary["bonds_broken"].get<long>() >=
