@@ -16,7 +16,7 @@ its older spelling tissue.contact.lip_release_depth_mm, which the stored records
 needle only below that needle's lip thickness: each needle then runs at its own values (`--needle-values HMB=0.2,0.4
 AMB=0.1,0.3`) and once with the whole lip crushed (the key set to "whole lip"; the label's value is `default`), and that run stands for it at every value from its lip
 thickness (the run's summary.json, lip_release.lip_thickness_mm) on; a needle with no values of its own (SB, no lip)
-runs only unset. Between its last value and its lip thickness a needle is interpolated towards the unset run.
+runs only that once. Between its last value and its lip thickness a needle is interpolated towards its whole-lip run.
 
 Writes into --out: sweep.json and sweep/ (the runs), and second_parameter.json and second_parameter.md (the tables).
 `--runs` analyses sweep folders run elsewhere (several: their cases are read by label); `--replica-runs` adds the
@@ -35,7 +35,7 @@ NEEDLES = ["SB", "LMB", "AMB", "HMB"]
 MULTI = ["LMB", "AMB", "HMB"]
 
 
-DEFAULT = "default"  # the label's value of a case with the key unset (--lip-depth)
+DEFAULT = "default"  # the label's value of the whole-lip case (--lip-depth; before 2026-11-29 it left the key unset)
 WHOLE_LIP = "whole lip"  # a depth key's value for the whole lip (solver/separation/lip_release.h, kWholeLipText)
 
 
