@@ -35,7 +35,7 @@ cat out/bench_levels/speed_error.csv
 # lip below a tip point crushed 0.48 mm deep, a depth fitted on HMB (data/paper/crushed_depth_hmb.json, which the report
 # names with its leave-one-needle-out errors; docs/notebook/crushed_depth.md, refitted in docs/notebook/multirate.md). Each needle's insertion is followed by the
 # trucut's third step, the cannula fired over the groove (--fire-cannula; the deflection is the insertion's, bit for
-# bit), so the report has both halves of the paper's design rule: the deflection and the sample length I_s. About 2–2.2
+# bit), so the report has both halves of the paper's design rule: the deflection and the sample length I_s. About 2
 # minutes a needle on 2 idle cores (about half of it the firing). A run the solver stops is reported as such in the report, not an error of the main job.
 # The report sets beside it, from their stored reports in docs/notebook/paper_results/, the tissue mass-scaled to a quarter
 # of the needle's step with the lip crushed 0.45 mm (the default until 2026-11-29), the whole lip crushed (the default
