@@ -7,8 +7,8 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "solver/separation/separation_models.h"
 #include "studies/paper_results.h"
@@ -527,9 +527,8 @@ TEST_CASE("needle paper names a parameter fitted on HMB, with its leave-one-out 
   std::string md = report_only(dir, "--fitted " + record_path.string());
   CHECK(md.find("## One more parameter fitted to a needle: the crushed lip's depth, on HMB alone") != std::string::npos);
   // The record spells the key as the study did (in the contact section); the report as scenes do today.
-  std::ostringstream named;
-  named << "`tissue.separation.lip.depth_mm` = " << needle::kSceneCrushedLipDepthMm << " mm in these runs is fitted on HMB (0.4521 fitted, rounded";
-  CHECK(md.find(named.str()) != std::string::npos);
+  CHECK(md.find(fmt::format("`tissue.separation.lip.depth_mm` = {} mm in these runs is fitted on HMB (0.4521 fitted, rounded",
+                            needle::kSceneCrushedLipDepthMm)) != std::string::npos);
   // The measured value is the prediction less its error: -0.011 + 0.251.
   CHECK(md.find("| AMB | LMB, HMB | 0.455 | -0.011 | +0.24 | -0.251 |") != std::string::npos);
   CHECK(md.find("the whole lip") == std::string::npos);  // the default lip goes unnamed in the model's description
