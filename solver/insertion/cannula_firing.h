@@ -36,11 +36,11 @@ struct CannulaFiringOptions {
   double lead_in_mm = 1.0;           // the stroke is simulated from this far behind the groove's back wall
   double edge_taper_mm = 0.2;        // the edge's bevel: the wall's full thickness this far behind the front
   // The tissue's mass scaling target from the firing on, where the run scales it (0: kMassScalingGrowth times the
-  // insertion's, the needle's whole step). The insertion's target, half the implicit needle's step, is for the needle's
-  // coupling; the held needle takes none, and the stroke is longer than the insertion (its effect is measured in
-  // docs/notebook/sampling.md).
+  // insertion's, twice the implicit needle's step). The insertion's target, half the implicit needle's step, is for the
+  // needle's coupling; the held needle takes none, and the stroke is longer than the insertion (its effect on the sample
+  // is measured in docs/notebook/sampling.md and multirate.md).
   double tissue_mass_scaling_dt_ms = 0.0;
-  static constexpr double kMassScalingGrowth = 2.0;
+  static constexpr double kMassScalingGrowth = 4.0;
   void validate(const std::string& where = "cannula.firing") const;  // InputError naming the bad field
   // The firing in a run's one-line description; empty when off.
   std::string describe() const;
