@@ -16,6 +16,8 @@ surrogates are validated against.
     /usr/bin/python3 studies/sensitivity/global_sensitivity.py --out study --analyze-only         # the tables again
     /usr/bin/python3 studies/sensitivity/global_sensitivity.py --out study --batches 2 --points 8  # batch 1's first 8 points
     /usr/bin/python3 studies/sensitivity/global_sensitivity.py --out study --batch 2              # batch 2 alone (the corners)
+    /usr/bin/python3 studies/sensitivity/global_sensitivity.py --out study --analyze-only --region crushed_depth_mm=0.43,0.8
+                                                            # the points of a region of the box alone (study_region.py)
 
 A study file's "kriging_trend" ("constant", the default, or "linear") is the surrogates' trend; its "held_out":
 {"from_batch": K} adds the held-out check (study_held_out.py): the procedure fitted on batches 0..K-1 predicts the
@@ -46,6 +48,7 @@ from study_design import (StudyError, batch_cases, batch_folder, corner_units, f
 from study_runs import (MEASURED_MM, PLATEAU, POOLED_SD_MM, case_records, complete_rows, point_runs, read_points,  # noqa: E402,F401
                         replica_scatter, response_view, responses, within_point_scatter)
 from study_held_out import held_out_checks, write_held_out  # noqa: E402
+from study_region import parse_region, region_label, region_study  # noqa: E402
 from study_surrogates import (MIN_Q2, RMSE_OVER_SCATTER, chaos_or_none, hsic_indices, joint_search,  # noqa: E402,F401
                               kriging_surrogate, run_distances)
 
@@ -162,14 +165,20 @@ def plot_scatter(path, study, views, table):
     plt.close(fig)
 
 
-def analyze(study, out, permutations=2000, top=3, root=None):
+def analyze(study, out, permutations=2000, top=3, root=None, regions=None):
+    """The analysis of the study's complete points into OUT/analysis; with regions ([(factor, lo, hi)], study_region.py),
+    of the points within them alone, the factors' ranges narrowed to them, into OUT/analysis_region_<factor>_<lo>_<hi>."""
     report_scatter = replica_scatter(study, root or os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")))
     records = read_points(study, out)
+    folder = os.path.join(out, "analysis")
+    if regions:
+        study, records = region_study(study, records, regions)
+        suffix, words = region_label(regions)
+        folder = os.path.join(out, f"analysis_region_{suffix}")
     rows, incomplete = complete_rows(study, records)
     within = within_point_scatter(study, rows)
     # One run's noise: measured between each point's own runs where the study has replicas, else the paper report's.
     scatter = {r: within[r][0] for r in within} if within else report_scatter
-    folder = os.path.join(out, "analysis")
     os.makedirs(folder, exist_ok=True)
     write_csv(os.path.join(folder, "points.csv"), rows)
     if len(rows) < 4:
@@ -207,6 +216,10 @@ def analyze(study, out, permutations=2000, top=3, root=None):
         json.dump(result, f, indent=1)
     os.replace(os.path.join(folder, "surrogate.json.tmp"), os.path.join(folder, "surrogate.json"))
     md = [f"# Global sensitivity: {len(rows)} complete design points x {len(study['needles'])} needles", ""]
+    if regions:
+        md.extend([f"The region {words} of the study's box: its points alone, those ranges the factors' own (a factor acting within "
+                   "the lip, narrowed to where it cannot act on a needle, drops out of that needle's surrogates); the held-out "
+                   "checks predict their points in the region from the region's other points. Nothing is run.", ""])
     bonferroni = 0.05 / len(study["factors"])
     md.append(f"R2-HSIC index (p-value by permutation) of each factor for each response; bold: p < 0.05; and a dagger where "
               f"p < {bonferroni:.4f}, which holds for the {len(study['factors'])} factors of a response together (Bonferroni): with "
@@ -309,6 +322,9 @@ def main(argv):
     p.add_argument("--design-only", action="store_true", help="write the sweep files only")
     p.add_argument("--analyze-only", action="store_true", help="analyse the finished cases only")
     p.add_argument("--permutations", type=int, default=2000, help="permutations of the HSIC p-values (default 2000)")
+    p.add_argument("--region", action="append", default=[], metavar="FACTOR=LO,HI",
+                   help="with --analyze-only: analyse only the points whose FACTOR lies in [LO, HI], that range then the factor's own "
+                        "(studies/sensitivity/study_region.py), into OUT/analysis_region_FACTOR_LO_HI; repeatable")
     args = p.parse_args(argv)
     try:
         study = read_study(args.study)
@@ -318,6 +334,11 @@ def main(argv):
             raise StudyError(f"--points must be between 1 and the study's batch_points ({study['batch_points']})")
         if args.batch is not None and args.batch < 0:
             raise StudyError("--batch must be at least 0")
+        regions = [parse_region(text, study) for text in args.region]
+        if regions and not args.analyze_only:
+            raise StudyError("--region analyses the stored points of a region: it goes with --analyze-only")
+        if len({n for n, _, _ in regions}) != len(regions):
+            raise StudyError("--region: each factor at most once")
         if not args.analyze_only:
             batches = [args.batch] if args.batch is not None else list(range(args.batches))
             for b in batches:
@@ -328,7 +349,7 @@ def main(argv):
                             raise StudyError(f"{args.needle}: no needle command (build it: bash scripts/build.sh needle)")
                         run_batch(args, path)
         if not args.design_only:
-            analyze(study, args.out, args.permutations)
+            analyze(study, args.out, args.permutations, regions=regions)
     except StudyError as e:
         print(f"global_sensitivity: error: {e}", file=sys.stderr)
         return 2

@@ -315,6 +315,34 @@ with tempfile.TemporaryDirectory() as tmp:
     check(result["hsic"]["ratio_AMB"]["crushed_depth_mm"]["p_value"] < 0.01 and "crushed_depth_mm" not in result["hsic"]["ratio_LMB"],
           "the analysis screens the depth on AMB's ratio and leaves it out of LMB's")
 
+    # A region of the box (--region): the points where the depth crushes AMB's lip whole, the depth's range narrowed to
+    # them. There the depth cannot act on any needle, so it drops out, and AMB's surrogate is the groove's line alone.
+    region = gs.analyze(lip_study, tmp, permutations=200, regions=[("crushed_depth_mm", 0.43, 0.8)])
+    inside = [r for r in rows if r["crushed_depth_mm"] >= 0.43]
+    check(region["points_complete"] == len(inside) and 8 <= len(inside) < len(rows),
+          f"the region holds the points with the depth at 0.43 mm or more ({region['points_complete']} of {len(rows)}: {len(inside)})")
+    check(all("crushed_depth_mm" not in region["hsic"][r] for r in region["responses"]),
+          "within the region the depth acts on no needle: it is left out of every response")
+    amb_region = next(s_ for s_ in region["surrogates"] if s_["response"] == "ratio_AMB")
+    check(amb_region["factors"] == ["groove_start_mm"] and amb_region["leave_one_out_q2"] > 0.9
+          and abs(amb_region["box_min"]["value"] - (-0.4)) < 0.02 and abs(amb_region["box_max"]["value"] - (-0.1)) < 0.02,
+          f"the region's AMB surrogate is the groove's line, -0.4..-0.1 ({amb_region['factors']}, Q2 {amb_region['leave_one_out_q2']:.3f}, "
+          f"{amb_region['box_min']['value']:+.3f}..{amb_region['box_max']['value']:+.3f})")
+    check(os.path.getsize(os.path.join(tmp, "analysis_region_crushed_depth_mm_0.43_0.8", "hsic.md")) > 0
+          and os.path.getsize(os.path.join(tmp, "analysis", "hsic.md")) > 0,
+          "the region's tables go to their own folder beside the whole box's")
+    lip_file = os.path.join(tmp, "lip_study.json")
+    with open(lip_file, "w") as f:
+        json.dump(lip_study, f)
+    for extra, words in ((["--analyze-only", "--region", "nosuch=1,2"], "FACTOR=LO,HI"),
+                         (["--analyze-only", "--region", "crushed_depth_mm=0.1,0.5"], "range"),
+                         (["--analyze-only", "--region", "crushed_depth_mm=0.5,0.4"], "LO < HI"),
+                         (["--region", "crushed_depth_mm=0.43,0.8"], "--analyze-only")):
+        r = subprocess.run([sys.executable, os.path.join(source, "studies", "sensitivity", "global_sensitivity.py"), "--study", lip_file,
+                            "--out", tmp] + extra, capture_output=True, text=True)
+        check(r.returncode == 2 and words in r.stderr and "Traceback" not in r.stderr,
+              f"{' '.join(extra)}: one clear error ({r.stderr.strip()})")
+
 # A partial batch (--points N): its sweep file is the whole batch's first N points; the whole batch later replaces it
 # (needle sweep then runs only the cases it has not recorded), and a shorter one after it is refused.
 with tempfile.TemporaryDirectory() as tmp:
