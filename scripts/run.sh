@@ -36,7 +36,7 @@ cat out/bench_levels/speed_error.csv
 # names with its leave-one-needle-out errors; docs/notebook/crushed_depth.md, refitted in docs/notebook/multirate.md). Each needle's insertion is followed by the
 # trucut's third step, the cannula fired over the groove (--fire-cannula; the deflection is the insertion's, bit for
 # bit), so the report has both halves of the paper's design rule: the deflection and the sample length I_s. About 2
-# minutes a needle on 2 idle cores (about half of it the firing). A run the solver stops is reported as such in the report, not an error of the main job.
+# minutes a needle on 2 idle cores (about 40 % of it the firing). A run the solver stops is reported as such in the report, not an error of the main job.
 # The report sets beside it, from their stored reports in docs/notebook/paper_results/, the tissue mass-scaled to a quarter
 # of the needle's step with the lip crushed 0.45 mm (the default until 2026-11-29), the whole lip crushed (the default
 # until 2026-11-28), the same at one rate, and the lip kept (before 2026-11-27; docs/notebook/lip_release.md). Three
