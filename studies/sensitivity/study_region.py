@@ -39,7 +39,7 @@ def region_label(regions):
 
 def region_study(study, records, regions):
     """The study with each region factor's range narrowed, and the records of the points within every region range
-    (a point's value as designed, to 1e-9 of the range)."""
+    (a point's value as designed, within 1e-9 of the bounds)."""
     narrowed = {n: (lo, hi) for n, lo, hi in regions}
     keys = {f["name"]: f["key"] for f in study["factors"]}
     factors = [dict(f, range=list(narrowed[f["name"]])) if f["name"] in narrowed else f for f in study["factors"]]
