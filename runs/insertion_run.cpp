@@ -223,6 +223,7 @@ class InsertionRunModel : public RunModel {
     // The groove at the insertion's end (with a fired cannula, before it: the sample is its own entry).
     const GrooveFill groove = at_insertion_end_ ? at_insertion_end_->groove : run_groove_fill(*run_, built_, scene_);
     summary["needle_steps"] = run_->needle_steps();
+    summary["needle_spans_ahead"] = run_->needle_spans_ahead();  // taken beside the tissue's update (solver.needle_ahead)
     // How many coupling steps each limit set (solver/insertion/coupled_insertion.h: StepLimit).
     json limits = json::object();
     for (int k = 0; k < kStepLimits; ++k) limits[step_limit_name(static_cast<StepLimit>(k))] = run_->step_limits()[static_cast<size_t>(k)];

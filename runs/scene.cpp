@@ -336,6 +336,7 @@ void read_solver(SceneObject o, SolverScene& s) {
   c.max_energy_error = s.max_energy_error;
   c.max_depth_mm = o.quantity("max_contact_depth", Dimension::length, c.max_depth_mm, positive());
   c.tissue_beside_needle = o.boolean("tissue_beside_needle", c.tissue_beside_needle);
+  c.needle_ahead = o.boolean("needle_ahead", c.needle_ahead);
   c.tissue_ahead_margin_mm = o.quantity("tissue_ahead_margin", Dimension::length, c.tissue_ahead_margin_mm, non_negative());
   c.tissue_rate_levels = o.integer("tissue_rate_levels", c.tissue_rate_levels, 0, 10);
   c.tissue_rate_needle_margin_mm = o.quantity("tissue_rate_needle_margin", Dimension::length, c.tissue_rate_needle_margin_mm, any_finite());
@@ -467,6 +468,7 @@ json scene_to_json(const Scene& s) {
   // Written only when not the default (the same results either way: a matter of speed).
   const CouplingOptions defaults;
   if (s.solver.coupling.tissue_beside_needle != defaults.tissue_beside_needle) solver["tissue_beside_needle"] = s.solver.coupling.tissue_beside_needle;
+  if (s.solver.coupling.needle_ahead != defaults.needle_ahead) solver["needle_ahead"] = s.solver.coupling.needle_ahead;
   if (s.solver.coupling.tissue_ahead_margin_mm != defaults.tissue_ahead_margin_mm)
     solver["tissue_ahead_margin_mm"] = s.solver.coupling.tissue_ahead_margin_mm;
   if (s.solver.coupling.tissue_rate_levels > 0) {  // multi-rate stepping (changes results): written with its margin

@@ -85,6 +85,10 @@ class NeedleTissueContact : public NeedleLoads {
   // carry their mid-step velocities (after velocity Verlet's drift); the needle is at the step's start.
   virtual void begin_step(const TissueParticles& particles, const Eigen::MatrixX3d& needle_x_mm, const Eigen::MatrixX3d& needle_v_mm_per_ms,
                           double start_time_ms, double dt_ms) = 0;
+  // Whether the needle's loads over the next step are set at this step's end (by end_step), whatever the particles
+  // and the needle do before the next begin_step: then begin_step may be called ahead, with the next step's length,
+  // from the state end_step left (the coupled insertion takes the needle's next span beside the tissue's work so).
+  virtual bool needle_loads_set_at_step_end() const { return false; }
   // (NeedleLoads::needle_forces: the contact's forces on the needle at time_ms within the step.)
   // Ends the step, the needle at the step's end: the law acts on the tissue between its drift and its
   // second half (a kinematic law moves the particles through `tissue`) and writes the forces the tissue's

@@ -39,6 +39,8 @@ class ProjectionContact : public NeedleTissueContact {
   // The last step's reaction becomes the needle's load over this step.
   void begin_step(const TissueParticles& particles, const Eigen::MatrixX3d& needle_x_mm, const Eigen::MatrixX3d& needle_v_mm_per_ms,
                   double start_time_ms, double dt_ms) override;
+  // Yes: the reaction end_step found, over the next step's length.
+  bool needle_loads_set_at_step_end() const override { return true; }
   // The reaction, constant over the step.
   void needle_forces(const Eigen::MatrixX3d& needle_x_mm, const Eigen::MatrixX3d& needle_v_mm_per_ms, double time_ms,
                      NodalForces& force_N) override;

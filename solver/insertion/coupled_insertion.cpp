@@ -60,22 +60,49 @@ void CoupledInsertion::step(double end_time_ms) {
   const double dt = tissue_dynamics_.kick_and_drift(plan_time_step(end_time_ms, limit));
   ++step_limits_[static_cast<size_t>(limit)];
   contact_->begin_step(tissue_.particles(), needle_.positions_mm(), needle_.velocities_mm_per_ms(), t, dt);
+  // The needle's span, or the one taken ahead beside the last step's forces when it was this one (needle_ahead):
+  // adopted where advance_to would run, after everything that reads the needle at the step's start.
   if (options_.tissue_beside_needle) {
     mark_particles_away_from_needle();
     needle_x_before_ = needle_.positions_mm();
-    run_beside([&] { needle_.advance_to(t + dt, loads_); }, [&] { tissue_.update_points_ahead(dt, still_); });
+    if (adopt_needle_span(t + dt)) tissue_.update_points_ahead(dt, still_);
+    else run_beside([&] { needle_.advance_to(t + dt, loads_); }, [&] { tissue_.update_points_ahead(dt, still_); });
     needle_motion_mm_ = (needle_.positions_mm() - needle_x_before_).rowwise().norm().maxCoeff();
-  } else {
+  } else if (!adopt_needle_span(t + dt)) {
     needle_.advance_to(t + dt, loads_);
   }
   contact_->end_step(tissue_dynamics_, needle_.positions_mm(), needle_.velocities_mm_per_ms(), contact_force_N_);
   if (firing_) firing_->push_tissue(tissue_dynamics_, needle_.positions_mm(), t + dt, dt);
-  tissue_dynamics_.finish_step(&contact_force_N_);
+  if (take_next_needle_span_ahead(t + dt, dt)) {
+    // The next span on the guess that the next step is as long as this one; its loads are set now (end_step) and the
+    // tissue's update does not touch them. begin_step is called again before the next span.
+    run_beside(
+        [&] {
+          contact_->begin_step(tissue_.particles(), needle_.positions_mm(), needle_.velocities_mm_per_ms(), t + dt, dt);
+          needle_.speculate_advance(t + dt + dt, loads_);
+        },
+        [&] { tissue_dynamics_.finish_step(&contact_force_N_); });
+  } else {
+    tissue_dynamics_.finish_step(&contact_force_N_);
+  }
   for (const std::unique_ptr<SeparationModel>& separation : separations_) separation->apply(tissue_, needle_);
   ++steps_;
   last_dt_ms_ = dt;
   energy_.update(needle_.energy(), tissue_dynamics_.energy(), *contact_, cutting_.get(), firing_ ? firing_->work_mJ() : 0.0);
   check_health();
+}
+
+bool CoupledInsertion::take_next_needle_span_ahead(double next_start_ms, double dt_ms) const {
+  if (!options_.needle_ahead || cutting_ || !contact_->needle_loads_set_at_step_end()) return false;
+  // The cannula's stroke holds the needle (held_needle.h refuses spans that reach its hold) and pushes the tissue.
+  if (firing_ && next_start_ms + dt_ms >= firing_->stroke().start_time_ms) return false;
+  return true;
+}
+
+bool CoupledInsertion::adopt_needle_span(double end_time_ms) {
+  const bool adopted = needle_.adopt_speculation(end_time_ms);
+  if (adopted) ++needle_spans_ahead_;
+  return adopted;
 }
 
 void CoupledInsertion::fire_cannula(CannulaFiring* firing) {

@@ -56,6 +56,12 @@ struct CouplingOptions {
   // a particle there stops with a SolverError.
   bool tissue_beside_needle = true;
   double tissue_ahead_margin_mm = 0.1;
+  // The needle's next span is taken beside the tissue's force update at the end of each step, on the guess that the
+  // next coupling step is as long as this one (true most steps: the steps are whole eighths of the implicit needle's
+  // and sit at the mass scaling's floor), and adopted when the guess holds: the same result, bit for bit, as
+  // without. Only where the needle's loads over a step are set at the last step's end (a kinematic contact, no
+  // cutting resistance) and the model can speculate (the implicit needle); false: never.
+  bool needle_ahead = true;
   // Multi-rate stepping of the tissue (tissue/tissue_rate_levels.h): the slowest points update every 2^levels
   // coupling steps (0: every point every step). The particles within this margin of the needle's box (widened by
   // the contact's skin) are held at the coupling step; negative: none held, the levels follow the particles' own
@@ -95,6 +101,8 @@ class CoupledInsertion {
   double last_step_ms() const { return last_dt_ms_; }
   // How many coupling steps each limit set, by StepLimit.
   const std::array<long, kStepLimits>& step_limits() const { return step_limits_; }
+  // How many of the needle's spans were taken ahead, beside the tissue's update (CouplingOptions::needle_ahead).
+  long needle_spans_ahead() const { return needle_spans_ahead_; }
   long needle_steps() const { return needle_.steps(); }
   // The loads on the needle at the last evaluation: the contact's, with the cutting resistance's added in.
   ContactReport contact() const;
@@ -144,6 +152,10 @@ class CoupledInsertion {
   CannulaFiring* firing_ = nullptr;
   std::vector<Vec3d> contact_force_N_;  // the contact's force on each particle at the step's end
   std::vector<std::uint8_t> still_;     // particles away from the needle this step
+  // Whether the needle's next span is taken ahead, beside the tissue's update at this step's end (needle_ahead).
+  bool take_next_needle_span_ahead(double next_start_ms, double dt_ms) const;
+  bool adopt_needle_span(double end_time_ms);  // the span taken ahead to end_time_ms, if there is one (counted)
+  long needle_spans_ahead_ = 0;         // the spans taken ahead and adopted
   Eigen::MatrixX3d needle_x_before_;    // the needle's nodes at the last step's start
   double needle_motion_mm_ = 0;         // the largest node motion over the last step
   InsertionEnergy energy_;

@@ -1,5 +1,6 @@
 #include "solver/needle/held_needle.h"
 
+#include <algorithm>
 #include <nlohmann/json.hpp>
 
 #include "core/input_error.h"
@@ -37,6 +38,20 @@ void HeldNeedle::advance_to(double end_time_ms, NeedleLoads& loads) {
   reaction_N_ = -sum;
   held_impulse_N_ms_ += (end_time_ms - time_ms_) * reaction_N_;
   time_ms_ = end_time_ms;
+}
+
+bool HeldNeedle::speculate_advance(double end_time_ms, NeedleLoads& loads) {
+  // advance_to's hold starts at the first span that reaches hold_from_ms_ (within its tolerance): only spans ending before it.
+  if (held_ || !(end_time_ms < hold_from_ms_ - 1e-12 * std::max(1.0, hold_from_ms_))) return false;
+  return inner_->speculate_advance(end_time_ms, loads);
+}
+
+bool HeldNeedle::adopt_speculation(double end_time_ms) {
+  if (held_ || !(end_time_ms < hold_from_ms_ - 1e-12 * std::max(1.0, hold_from_ms_))) {
+    inner_->adopt_speculation(-1);  // drops any kept one
+    return false;
+  }
+  return inner_->adopt_speculation(end_time_ms);
 }
 
 void HeldNeedle::add_summary(nlohmann::json& summary) const {

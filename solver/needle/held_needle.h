@@ -25,6 +25,9 @@ class HeldNeedle : public NeedleModel {
   double step_grid_ms() const override { return inner_->step_grid_ms(); }
   void apply_loads(NeedleLoads& loads) override { inner_->apply_loads(loads); }
   void advance_to(double end_time_ms, NeedleLoads& loads) override;
+  // The inner model's, for a span that ends before the hold.
+  bool speculate_advance(double end_time_ms, NeedleLoads& loads) override;
+  bool adopt_speculation(double end_time_ms) override;
   double time_ms() const override { return held() ? time_ms_ : inner_->time_ms(); }
   long steps() const override { return inner_->steps(); }
   const Eigen::MatrixX3d& positions_mm() const override { return inner_->positions_mm(); }

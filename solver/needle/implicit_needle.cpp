@@ -167,6 +167,61 @@ void ImplicitNeedle::advance_to(double end_time_ms, NeedleLoads& loads) {
   while (end_time_ms - time_ms_ > tolerance) step(end_time_ms - time_ms_ > step_ms_ + tolerance ? step_ms_ : end_time_ms - time_ms_, loads);
 }
 
+ImplicitNeedle::State ImplicitNeedle::capture() const {
+  return State{w_,      wd_,       wdd_,     load_,   cannula_load_, old_load_,   old_cannula_load_,           cannula_normal_N_, x_,
+               v_,      external_, contact_, max_cannula_penetration_mm_, time_ms_, steps_, energy_, drive_reaction_, drive_impulse_};
+}
+
+void ImplicitNeedle::restore(State&& s) {
+  w_ = std::move(s.w);
+  wd_ = std::move(s.wd);
+  wdd_ = std::move(s.wdd);
+  load_ = std::move(s.load);
+  cannula_load_ = std::move(s.cannula_load);
+  old_load_ = std::move(s.old_load);
+  old_cannula_load_ = std::move(s.old_cannula_load);
+  cannula_normal_N_ = std::move(s.cannula_normal_N);
+  x_ = std::move(s.x);
+  v_ = std::move(s.v);
+  external_ = std::move(s.external);
+  contact_ = s.contact;
+  max_cannula_penetration_mm_ = s.max_cannula_penetration_mm;
+  time_ms_ = s.time_ms;
+  steps_ = s.steps;
+  energy_ = s.energy;
+  drive_reaction_ = s.drive_reaction;
+  drive_impulse_ = s.drive_impulse;
+}
+
+bool ImplicitNeedle::speculate_advance(double end_time_ms, NeedleLoads& loads) {
+  speculation_.reset();
+  State before = capture();
+  const long from_steps = steps_;
+  const double from_ms = time_ms_;
+  bool made = true;
+  try {
+    advance_to(end_time_ms, loads);
+  } catch (...) {  // the real span will fail the same way, and say why
+    made = false;
+  }
+  if (made) {
+    speculation_ = capture();
+    speculation_from_steps_ = from_steps;
+    speculation_from_ms_ = from_ms;
+    speculation_end_ms_ = end_time_ms;
+  }
+  restore(std::move(before));
+  return made;
+}
+
+bool ImplicitNeedle::adopt_speculation(double end_time_ms) {
+  if (!speculation_) return false;
+  const bool same = speculation_from_steps_ == steps_ && speculation_from_ms_ == time_ms_ && speculation_end_ms_ == end_time_ms;
+  if (same) restore(std::move(*speculation_));
+  speculation_.reset();
+  return same;
+}
+
 void ImplicitNeedle::step(double dt, NeedleLoads& loads) {
   Factor& factor = factor_for(dt);
   const double t0 = time_ms_, t1 = time_ms_ + dt;

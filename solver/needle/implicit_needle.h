@@ -54,6 +54,8 @@ class ImplicitNeedle : public NeedleModel {
   double step_grid_ms() const override { return step_ms_ / 8; }
   void apply_loads(NeedleLoads& loads) override;
   void advance_to(double end_time_ms, NeedleLoads& loads) override;
+  bool speculate_advance(double end_time_ms, NeedleLoads& loads) override;
+  bool adopt_speculation(double end_time_ms) override;
 
   double time_ms() const override { return time_ms_; }
   long steps() const override { return steps_; }
@@ -85,6 +87,20 @@ class ImplicitNeedle : public NeedleModel {
   void update_state();        // x_, v_ from w, w' and the drive
   void start_accelerations();  // w'' in equilibrium with the held loads at the current state
 
+  // Everything a step changes (the factor cache and its counts aside: the same factors either way).
+  struct State {
+    Eigen::VectorXd w, wd, wdd, load, cannula_load, old_load, old_cannula_load, cannula_normal_N;
+    Eigen::MatrixX3d x, v;
+    NodalForces external;
+    CannulaContact contact;
+    double max_cannula_penetration_mm = 0, time_ms = 0;
+    long steps = 0;
+    NeedleEnergy energy;
+    Eigen::Vector3d drive_reaction = Eigen::Vector3d::Zero(), drive_impulse = Eigen::Vector3d::Zero();
+  };
+  State capture() const;
+  void restore(State&& state);
+
   const FeNeedle& needle_;
   NeedleSupports supports_;
   NeedleDynamicsOptions options_;
@@ -113,6 +129,10 @@ class ImplicitNeedle : public NeedleModel {
   long steps_ = 0;
   NeedleEnergy energy_;
   Eigen::Vector3d drive_reaction_ = Eigen::Vector3d::Zero(), drive_impulse_ = Eigen::Vector3d::Zero();
+  // The kept speculation: made from the state at (steps, time) to end_ms.
+  std::optional<State> speculation_;
+  long speculation_from_steps_ = -1;
+  double speculation_from_ms_ = 0, speculation_end_ms_ = 0;
 };
 
 }  // namespace needle

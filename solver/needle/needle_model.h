@@ -56,6 +56,14 @@ class NeedleModel {
   virtual void apply_loads(NeedleLoads& loads) = 0;
   // Takes its own steps up to end_time_ms, re-evaluating loads at each.
   virtual void advance_to(double end_time_ms, NeedleLoads& loads) = 0;
+  // Speculation, so that the coupled insertion can take the needle's next span beside the tissue's work (its solve is
+  // serial): computes what advance_to(end_time_ms, loads) would give from the current state and keeps it, leaving the
+  // state as it was. adopt_speculation(end_time_ms) then takes the kept result, bit for bit what advance_to would give,
+  // if it was made from the current state to that time (true), and drops it either way; the caller must make sure the
+  // loads would have been the same. A model that cannot (the default) returns false from both; so does a span that
+  // failed (advance_to will then fail the same way).
+  virtual bool speculate_advance(double /*end_time_ms*/, NeedleLoads& /*loads*/) { return false; }
+  virtual bool adopt_speculation(double /*end_time_ms*/) { return false; }
 
   virtual double time_ms() const = 0;
   virtual long steps() const = 0;

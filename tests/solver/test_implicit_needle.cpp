@@ -181,6 +181,53 @@ TEST_CASE("Implicit needle: driven at its base it moves with the drive and the d
   CHECK_THROWS_AS(ImplicitNeedle(fe, driven_base_supports(fe.mesh(), profile), std::nullopt, options), InputError);
 }
 
+TEST_CASE("Implicit needle: a span taken ahead leaves the state as it was, and adopted it is the span advance_to takes, bit for bit",
+          "[solver][needle][gmsh][ahead]") {
+  const FeNeedle fe(rod(), NeedleMaterial{}, 0.0);
+  InsertionProfile profile;
+  profile.accel_time_ms = 0.02;
+  profile.speed_mm_per_ms = 8.0;
+  profile.travel_mm = 0.3;
+  NeedleDynamicsOptions options;
+  options.implicit_step_ms = 1e-3;
+  TipLoad load;
+  load.nodes = tip_nodes(fe.mesh());
+  load.total_N = 0.01;
+  load.ramp_ms = 0.01;
+  ImplicitNeedle plain(fe, driven_base_supports(fe.mesh(), profile), std::nullopt, options);
+  ImplicitNeedle ahead(fe, driven_base_supports(fe.mesh(), profile), std::nullopt, options);
+  // Spans of 0.75 and 2.5 steps, the second a whole step and a remainder.
+  const std::vector<double> ends = {0.75e-3, 3.25e-3, 4.0e-3, 6.5e-3};
+  for (size_t k = 0; k < ends.size(); ++k) {
+    const Eigen::MatrixX3d before = ahead.positions_mm();
+    const long steps_before = ahead.steps();
+    REQUIRE(ahead.speculate_advance(ends[k], load));
+    // Nothing moved, and a span to another time is not adopted (and the kept one is dropped).
+    CHECK(ahead.positions_mm() == before);
+    CHECK(ahead.steps() == steps_before);
+    CHECK(ahead.time_ms() == plain.time_ms());
+    if (k == 2) {
+      CHECK_FALSE(ahead.adopt_speculation(ends[k] + 1e-4));
+      CHECK_FALSE(ahead.adopt_speculation(ends[k]));  // dropped
+      ahead.advance_to(ends[k], load);
+    } else {
+      CHECK(ahead.adopt_speculation(ends[k]));
+    }
+    plain.advance_to(ends[k], load);
+    CHECK(ahead.positions_mm() == plain.positions_mm());
+    CHECK(ahead.velocities_mm_per_ms() == plain.velocities_mm_per_ms());
+    CHECK(ahead.steps() == plain.steps());
+    CHECK(ahead.time_ms() == plain.time_ms());
+    CHECK(ahead.energy().strain_mJ == plain.energy().strain_mJ);
+    CHECK(ahead.energy().drive_work_mJ == plain.energy().drive_work_mJ);
+    CHECK(ahead.drive_impulse_N_ms() == plain.drive_impulse_N_ms());
+  }
+  // A speculation made before the state moved on is not adopted.
+  REQUIRE(ahead.speculate_advance(8e-3, load));
+  ahead.advance_to(7e-3, load);
+  CHECK_FALSE(ahead.adopt_speculation(8e-3));
+}
+
 TEST_CASE("Implicit needle: stopped at once after its travel it rings with the kinetic energy it had, less its base's", "[solver][needle][gmsh]") {
   // The drive ends at full speed and then holds the base (no deceleration): the base stops at once, the rest of the rod
   // keeps its velocity and rings axially. Its energy after the stop is what it had less the held base's kinetic energy
