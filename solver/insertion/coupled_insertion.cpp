@@ -93,7 +93,7 @@ void CoupledInsertion::step(double end_time_ms) {
 }
 
 bool CoupledInsertion::take_next_needle_span_ahead(double next_start_ms, double dt_ms) const {
-  if (!options_.needle_ahead || cutting_ || !contact_->needle_loads_set_at_step_end()) return false;
+  if (!options_.needle_ahead || cutting_ || !contact_->needle_loads_set_at_step_end() || !needle_.can_speculate()) return false;
   // The cannula's stroke holds the needle (held_needle.h refuses spans that reach its hold) and pushes the tissue.
   if (firing_ && next_start_ms + dt_ms >= firing_->stroke().start_time_ms) return false;
   return true;

@@ -26,6 +26,7 @@ class HeldNeedle : public NeedleModel {
   void apply_loads(NeedleLoads& loads) override { inner_->apply_loads(loads); }
   void advance_to(double end_time_ms, NeedleLoads& loads) override;
   // The inner model's, for a span that ends before the hold.
+  bool can_speculate() const override { return !held_ && inner_->can_speculate(); }
   bool speculate_advance(double end_time_ms, NeedleLoads& loads) override;
   bool adopt_speculation(double end_time_ms) override;
   double time_ms() const override { return held() ? time_ms_ : inner_->time_ms(); }

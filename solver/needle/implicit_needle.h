@@ -54,6 +54,7 @@ class ImplicitNeedle : public NeedleModel {
   double step_grid_ms() const override { return step_ms_ / 8; }
   void apply_loads(NeedleLoads& loads) override;
   void advance_to(double end_time_ms, NeedleLoads& loads) override;
+  bool can_speculate() const override { return true; }
   bool speculate_advance(double end_time_ms, NeedleLoads& loads) override;
   bool adopt_speculation(double end_time_ms) override;
 

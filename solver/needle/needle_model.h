@@ -61,7 +61,8 @@ class NeedleModel {
   // state as it was. adopt_speculation(end_time_ms) then takes the kept result, bit for bit what advance_to would give,
   // if it was made from the current state to that time (true), and drops it either way; the caller must make sure the
   // loads would have been the same. A model that cannot (the default) returns false from both; so does a span that
-  // failed (advance_to will then fail the same way).
+  // failed (advance_to will then fail the same way). can_speculate says whether the model ever can.
+  virtual bool can_speculate() const { return false; }
   virtual bool speculate_advance(double /*end_time_ms*/, NeedleLoads& /*loads*/) { return false; }
   virtual bool adopt_speculation(double /*end_time_ms*/) { return false; }
 

@@ -545,6 +545,12 @@ TEST_CASE("The needle's next span, taken ahead beside the tissue's update and ad
   CHECK(particles[1] == particles[0]);
   CHECK(nodes[1] == nodes[0]);
   CHECK(needle_energy[1] == needle_energy[0]);
+  // The explicit FE needle cannot take a span ahead: under the same contact it takes none (and is not asked to).
+  Insertion explicit_needle(mesh, 0.0, {"fe"}, quick_profile(0.1), Eigen::Vector3d::UnitX(), block(3.0, 1.6, 1.2, 0.4, false),
+                            CouplingOptions{}, projection());
+  CHECK_FALSE(explicit_needle.dynamics.can_speculate());
+  for (int k = 0; k < 5; ++k) explicit_needle.run.step(quick_profile(0.1).end_time_ms());
+  CHECK(explicit_needle.run.needle_spans_ahead() == 0);
 }
 
 TEST_CASE("Multi-rate tissue: a free block hit by the implicit needle exchanges momentum exactly, balances energy, and updates beside "

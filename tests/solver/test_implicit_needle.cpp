@@ -196,6 +196,7 @@ TEST_CASE("Implicit needle: a span taken ahead leaves the state as it was, and a
   load.ramp_ms = 0.01;
   ImplicitNeedle plain(fe, driven_base_supports(fe.mesh(), profile), std::nullopt, options);
   ImplicitNeedle ahead(fe, driven_base_supports(fe.mesh(), profile), std::nullopt, options);
+  CHECK(ahead.can_speculate());
   // Spans of 0.75 and 2.5 steps, the second a whole step and a remainder.
   const std::vector<double> ends = {0.75e-3, 3.25e-3, 4.0e-3, 6.5e-3};
   for (size_t k = 0; k < ends.size(); ++k) {
