@@ -4,6 +4,12 @@
 //  2. Explicit steps per second on the paper's 0.2 mm T10 half mesh (SB and LMB), with the stable
 //     step, the run length the paper's 4.125 ms profile would take, and what selective mass scaling
 //     buys (step, added mass).
+//  3. The implicit needle's step solve on the run defaults' 0.4 mm T10 half mesh of SB: the default model's longest
+//     serial path (about 5 ms a needle step, a third of SB's wall time: docs/notebook/multirate.md), by the
+//     factorisation the model uses and by others, with each one's difference from it (a cheaper one changes the
+//     rounding, so results would move within their scatter and E would be recalibrated).
+#include <Eigen/CholmodSupport>
+#include <Eigen/SparseCholesky>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -98,6 +104,70 @@ int main(int argc, char** argv) {
       const FeNeedle scaled(mesh, steel, target);
       fmt::print("    {:8.0e} ms -> {:7.2f} % in {:6} elements, {:8.0f} steps\n", target, 100 * scaled.added_mass_g() / scaled.physical_mass_g(),
                  scaled.mass_scaled_elements(), 4.125 / (0.9 * scaled.stable_time_step_ms()));
+    }
+  }
+
+  // 3. The implicit needle's solve.
+  {
+    const TipGeometry tip = resolve_tip(preset_recipe("SB"));
+    const FeNeedle needle(mesh_of(tip, true, 2, 0.4), steel);
+    const NeedleSupports supports = driven_base_supports(needle.mesh(), InsertionProfile{});
+    const int n = needle.num_nodes();
+    std::vector<int> index(3 * static_cast<size_t>(n), 0);
+    for (int i : supports.driven)
+      for (int k = 0; k < 3; ++k) index[3 * static_cast<size_t>(i) + k] = -1;
+    for (int i : supports.symmetry) index[3 * static_cast<size_t>(i) + 2] = -1;
+    int free = 0;
+    for (int& f : index)
+      if (f == 0) f = free++;
+    // A = K + 4/h^2 M on the free components, h the paper scene's implicit step (0.002 ms), as ImplicitNeedle builds it.
+    const double h = 0.002;
+    const Eigen::SparseMatrix<double> K = needle.stiffness_matrix();
+    std::vector<Eigen::Triplet<double>> entries;
+    for (int col = 0; col < K.outerSize(); ++col)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(K, col); it; ++it) {
+        const int r = index[static_cast<size_t>(it.row())], c = index[static_cast<size_t>(it.col())];
+        if (r >= 0 && c >= 0 && r >= c) entries.emplace_back(r, c, it.value());
+      }
+    for (int d = 0; d < 3 * n; ++d)
+      if (index[static_cast<size_t>(d)] >= 0) entries.emplace_back(index[static_cast<size_t>(d)], index[static_cast<size_t>(d)], 4 / (h * h) * needle.nodal_mass_g()[d / 3]);
+    Eigen::SparseMatrix<double> A(free, free);
+    A.setFromTriplets(entries.begin(), entries.end());
+    const Eigen::VectorXd rhs = Eigen::VectorXd::Random(free);
+    constexpr int kSolves = 200;
+    fmt::print("\nThe implicit needle's step solve: SB, 0.4 mm T10 half mesh, {} elements, {} free components, h {} ms ({} solves)\n",
+               needle.num_elements(), free, h, kSolves);
+    fmt::print("{:>34} {:>10} {:>12} {:>12} {:>16}\n", "factorisation", "factor s", "solve ms", "nnz(L)", "max |x - x_model|/|x|");
+    Eigen::VectorXd reference;
+    const auto measure = [&](const std::string& name, auto& solver, long nnz) {
+      const auto t0 = Clock::now();
+      solver.compute(A.selfadjointView<Eigen::Lower>());
+      const double factor_s = since(t0);
+      Eigen::VectorXd x;
+      const auto t1 = Clock::now();
+      for (int k = 0; k < kSolves; ++k) x = solver.solve(rhs);
+      const double solve_ms = 1e3 * since(t1) / kSolves;
+      if (reference.size() == 0) reference = x;
+      const double difference = (x - reference).cwiseAbs().maxCoeff() / reference.cwiseAbs().maxCoeff();
+      fmt::print("{:>34} {:>10.3f} {:>12.3f} {:>12} {:>16.2e}\n", name, factor_s, solve_ms, nnz < 0 ? std::string("-") : std::to_string(nnz), difference);
+    };
+    {
+      Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>> model;
+      measure("CHOLMOD supernodal LLT (the model)", model, -1);
+    }
+    {
+      Eigen::CholmodSimplicialLLT<Eigen::SparseMatrix<double>> simplicial;
+      measure("CHOLMOD simplicial LLT", simplicial, -1);
+    }
+    {
+      Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> eigen_llt;
+      eigen_llt.compute(A.selfadjointView<Eigen::Lower>());
+      measure("Eigen simplicial LLT (AMD)", eigen_llt, static_cast<long>(eigen_llt.matrixL().nestedExpression().nonZeros()));
+    }
+    {
+      Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> eigen_ldlt;
+      eigen_ldlt.compute(A.selfadjointView<Eigen::Lower>());
+      measure("Eigen simplicial LDLT (AMD)", eigen_ldlt, static_cast<long>(eigen_ldlt.matrixL().nestedExpression().nonZeros()));
     }
   }
   return 0;

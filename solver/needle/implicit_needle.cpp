@@ -172,6 +172,15 @@ ImplicitNeedle::State ImplicitNeedle::capture() const {
                v_,      external_, contact_, max_cannula_penetration_mm_, time_ms_, steps_, energy_, drive_reaction_, drive_impulse_};
 }
 
+ImplicitNeedle::State ImplicitNeedle::release() {
+  return State{std::move(w_),       std::move(wd_),           std::move(wdd_),
+               std::move(load_),    std::move(cannula_load_), std::move(old_load_),
+               std::move(old_cannula_load_), std::move(cannula_normal_N_), std::move(x_),
+               std::move(v_),       std::move(external_),     contact_,
+               max_cannula_penetration_mm_,  time_ms_,        steps_,
+               energy_,             drive_reaction_,          drive_impulse_};
+}
+
 void ImplicitNeedle::restore(State&& s) {
   w_ = std::move(s.w);
   wd_ = std::move(s.wd);
@@ -205,7 +214,7 @@ bool ImplicitNeedle::speculate_advance(double end_time_ms, NeedleLoads& loads) {
     made = false;
   }
   if (made) {
-    speculation_ = capture();
+    speculation_ = release();
     speculation_from_steps_ = from_steps;
     speculation_from_ms_ = from_ms;
     speculation_end_ms_ = end_time_ms;

@@ -100,6 +100,7 @@ class ImplicitNeedle : public NeedleModel {
     Eigen::Vector3d drive_reaction = Eigen::Vector3d::Zero(), drive_impulse = Eigen::Vector3d::Zero();
   };
   State capture() const;
+  State release();  // the state moved out (the members are left empty until restore)
   void restore(State&& state);
 
   const FeNeedle& needle_;
