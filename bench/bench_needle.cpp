@@ -20,6 +20,7 @@
 #include "geometry/grinding_recipe.h"
 #include "mesher/needle_mesher.h"
 #include "solver/needle/beam_reference.h"
+#include "solver/needle/implicit_needle.h"
 #include "solver/needle/needle_dynamics.h"
 #include "solver/needle/needle_stiffness.h"
 #include "core/parallel.h"
@@ -111,35 +112,21 @@ int main(int argc, char** argv) {
   {
     const TipGeometry tip = resolve_tip(preset_recipe("SB"));
     const FeNeedle needle(mesh_of(tip, true, 2, 0.4), steel);
-    const NeedleSupports supports = driven_base_supports(needle.mesh(), InsertionProfile{});
-    const int n = needle.num_nodes();
-    std::vector<int> index(3 * static_cast<size_t>(n), 0);
-    for (int i : supports.driven)
-      for (int k = 0; k < 3; ++k) index[3 * static_cast<size_t>(i) + k] = -1;
-    for (int i : supports.symmetry) index[3 * static_cast<size_t>(i) + 2] = -1;
-    int free = 0;
-    for (int& f : index)
-      if (f == 0) f = free++;
-    // A = K + 4/h^2 M on the free components, h the paper scene's implicit step (0.002 ms), as ImplicitNeedle builds it.
+    // A = K + 4/h^2 M on the free components, h the paper scene's implicit step (0.002 ms): the model's own matrix.
     const double h = 0.002;
-    const Eigen::SparseMatrix<double> K = needle.stiffness_matrix();
-    std::vector<Eigen::Triplet<double>> entries;
-    for (int col = 0; col < K.outerSize(); ++col)
-      for (Eigen::SparseMatrix<double>::InnerIterator it(K, col); it; ++it) {
-        const int r = index[static_cast<size_t>(it.row())], c = index[static_cast<size_t>(it.col())];
-        if (r >= 0 && c >= 0 && r >= c) entries.emplace_back(r, c, it.value());
-      }
-    for (int d = 0; d < 3 * n; ++d)
-      if (index[static_cast<size_t>(d)] >= 0) entries.emplace_back(index[static_cast<size_t>(d)], index[static_cast<size_t>(d)], 4 / (h * h) * needle.nodal_mass_g()[d / 3]);
-    Eigen::SparseMatrix<double> A(free, free);
-    A.setFromTriplets(entries.begin(), entries.end());
+    NeedleDynamicsOptions options;
+    options.implicit_step_ms = h;
+    const ImplicitNeedle model(needle, driven_base_supports(needle.mesh(), InsertionProfile{}), std::nullopt, options);
+    const Eigen::SparseMatrix<double> A = model.step_matrix(h);
+    const Eigen::Index free = A.rows();
     const Eigen::VectorXd rhs = Eigen::VectorXd::Random(free);
     constexpr int kSolves = 200;
     fmt::print("\nThe implicit needle's step solve: SB, 0.4 mm T10 half mesh, {} elements, {} free components, h {} ms ({} solves)\n",
                needle.num_elements(), free, h, kSolves);
     fmt::print("{:>34} {:>10} {:>12} {:>12} {:>16}\n", "factorisation", "factor s", "solve ms", "nnz(L)", "max |x - x_model|/|x|");
     Eigen::VectorXd reference;
-    const auto measure = [&](const std::string& name, auto& solver, long nnz) {
+    // nnz: the factor's entries once computed (-1: not known).
+    const auto measure = [&](const std::string& name, auto& solver, const auto& nnz_of) {
       const auto t0 = Clock::now();
       solver.compute(A.selfadjointView<Eigen::Lower>());
       const double factor_s = since(t0);
@@ -149,25 +136,26 @@ int main(int argc, char** argv) {
       const double solve_ms = 1e3 * since(t1) / kSolves;
       if (reference.size() == 0) reference = x;
       const double difference = (x - reference).cwiseAbs().maxCoeff() / reference.cwiseAbs().maxCoeff();
+      const long nnz = nnz_of(solver);
       fmt::print("{:>34} {:>10.3f} {:>12.3f} {:>12} {:>16.2e}\n", name, factor_s, solve_ms, nnz < 0 ? std::string("-") : std::to_string(nnz), difference);
     };
+    const auto unknown = [](const auto&) { return -1L; };
+    const auto entries = [](const auto& f) { return static_cast<long>(f.matrixL().nestedExpression().nonZeros()); };
     {
-      Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>> model;
-      measure("CHOLMOD supernodal LLT (the model)", model, -1);
+      Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>> supernodal;
+      measure("CHOLMOD supernodal LLT (the model)", supernodal, unknown);
     }
     {
       Eigen::CholmodSimplicialLLT<Eigen::SparseMatrix<double>> simplicial;
-      measure("CHOLMOD simplicial LLT", simplicial, -1);
+      measure("CHOLMOD simplicial LLT", simplicial, unknown);
     }
     {
       Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> eigen_llt;
-      eigen_llt.compute(A.selfadjointView<Eigen::Lower>());
-      measure("Eigen simplicial LLT (AMD)", eigen_llt, static_cast<long>(eigen_llt.matrixL().nestedExpression().nonZeros()));
+      measure("Eigen simplicial LLT (AMD)", eigen_llt, entries);
     }
     {
       Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> eigen_ldlt;
-      eigen_ldlt.compute(A.selfadjointView<Eigen::Lower>());
-      measure("Eigen simplicial LDLT (AMD)", eigen_ldlt, static_cast<long>(eigen_ldlt.matrixL().nestedExpression().nonZeros()));
+      measure("Eigen simplicial LDLT (AMD)", eigen_ldlt, entries);
     }
   }
   return 0;

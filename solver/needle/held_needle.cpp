@@ -1,6 +1,5 @@
 #include "solver/needle/held_needle.h"
 
-#include <algorithm>
 #include <nlohmann/json.hpp>
 
 #include "core/input_error.h"
@@ -26,7 +25,7 @@ void HeldNeedle::hold() {
 void HeldNeedle::advance_to(double end_time_ms, NeedleLoads& loads) {
   if (!held_) {
     inner_->advance_to(std::min(end_time_ms, hold_from_ms_), loads);
-    if (inner_->time_ms() < hold_from_ms_ - 1e-12 * std::max(1.0, hold_from_ms_)) return;
+    if (before_hold(inner_->time_ms())) return;
     hold();
   }
   if (end_time_ms <= time_ms_) return;
@@ -41,13 +40,13 @@ void HeldNeedle::advance_to(double end_time_ms, NeedleLoads& loads) {
 }
 
 bool HeldNeedle::speculate_advance(double end_time_ms, NeedleLoads& loads) {
-  // advance_to's hold starts at the first span that reaches hold_from_ms_ (within its tolerance): only spans ending before it.
-  if (held_ || !(end_time_ms < hold_from_ms_ - 1e-12 * std::max(1.0, hold_from_ms_))) return false;
+  // advance_to's hold starts at the first span that reaches it: only spans ending before it.
+  if (held_ || !before_hold(end_time_ms)) return false;
   return inner_->speculate_advance(end_time_ms, loads);
 }
 
 bool HeldNeedle::adopt_speculation(double end_time_ms) {
-  if (held_ || !(end_time_ms < hold_from_ms_ - 1e-12 * std::max(1.0, hold_from_ms_))) {
+  if (held_ || !before_hold(end_time_ms)) {
     inner_->adopt_speculation(-1);  // drops any kept one
     return false;
   }

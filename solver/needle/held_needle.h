@@ -8,6 +8,7 @@
 // held_mJ, stored beside the strain energy), so the run's energy account stays closed and keeps its scale; the strain
 // energy stays as it was. The loads are still evaluated at each step (at zero
 // velocity), so a contact law's own account goes on, and the reaction the supports give is their sum, negated.
+#include <algorithm>
 #include <memory>
 
 #include "solver/needle/needle_model.h"
@@ -41,6 +42,8 @@ class HeldNeedle : public NeedleModel {
   void add_summary(nlohmann::json& summary) const override;
 
   bool held() const { return held_; }
+  // Whether time_ms lies before the hold (within the rounding of summed steps: 1e-12 of it).
+  bool before_hold(double time_ms) const { return time_ms < hold_from_ms_ - 1e-12 * std::max(1.0, hold_from_ms_); }
   double hold_from_ms() const { return hold_from_ms_; }
   double kinetic_energy_taken_mJ() const { return taken_mJ_; }  // the inner model's at the hold
 

@@ -69,12 +69,12 @@ ImplicitNeedle::ImplicitNeedle(const FeNeedle& needle, NeedleSupports supports, 
       cannula_k_.push_back(cannula->penalty_scale * mass_[node] / (dt_fe * dt_fe));
     }
   }
-  cannula_normal_N_ = Eigen::VectorXd::Zero(n);
+  state_.cannula_normal_N = Eigen::VectorXd::Zero(n);
 
-  w_ = wd_ = wdd_ = load_ = cannula_load_ = Eigen::VectorXd::Zero(3 * n);
-  old_load_ = old_cannula_load_ = load_;
-  x_ = needle.mesh().X;
-  v_ = Eigen::MatrixX3d::Zero(n, 3);
+  state_.w = state_.wd = state_.wdd = state_.load = state_.cannula_load = Eigen::VectorXd::Zero(3 * n);
+  state_.old_load = state_.old_cannula_load = state_.load;
+  state_.x = needle.mesh().X;
+  state_.v = Eigen::MatrixX3d::Zero(n, 3);
   update_state();
   start_accelerations();
 }
@@ -82,61 +82,67 @@ ImplicitNeedle::ImplicitNeedle(const FeNeedle& needle, NeedleSupports supports, 
 ImplicitNeedle::~ImplicitNeedle() = default;
 
 void ImplicitNeedle::update_state() {
-  const Eigen::RowVector3d d = (supports_.profile.displacement_mm(time_ms_) * supports_.direction).transpose();
-  const Eigen::RowVector3d s = (supports_.profile.velocity_mm_per_ms(time_ms_) * supports_.direction).transpose();
+  const Eigen::RowVector3d d = (supports_.profile.displacement_mm(state_.time_ms) * supports_.direction).transpose();
+  const Eigen::RowVector3d s = (supports_.profile.velocity_mm_per_ms(state_.time_ms) * supports_.direction).transpose();
   const Eigen::MatrixX3d& X = needle_.mesh().X;
   for (Eigen::Index i = 0; i < X.rows(); ++i)
     for (int k = 0; k < 3; ++k) {
-      x_(i, k) = X(i, k) + d[k] + w_[3 * i + k];
-      v_(i, k) = s[k] + wd_[3 * i + k];
+      state_.x(i, k) = X(i, k) + d[k] + state_.w[3 * i + k];
+      state_.v(i, k) = s[k] + state_.wd[3 * i + k];
     }
 }
 
 void ImplicitNeedle::evaluate_loads(NeedleLoads& loads) {
-  external_.clear();
-  loads.needle_forces(x_, v_, time_ms_, external_);
-  load_.setZero();
-  for (const auto& [node, f] : external_) {
-    NEEDLE_REQUIRE(node >= 0 && node < x_.rows(), "external needle force on a node that does not exist");
-    load_.segment<3>(3 * node) += f;
+  state_.external.clear();
+  loads.needle_forces(state_.x, state_.v, state_.time_ms, state_.external);
+  state_.load.setZero();
+  for (const auto& [node, f] : state_.external) {
+    NEEDLE_REQUIRE(node >= 0 && node < state_.x.rows(), "external needle force on a node that does not exist");
+    state_.load.segment<3>(3 * node) += f;
   }
   // The cannula's friction, from the last step's normal forces, against each node's sliding.
-  cannula_load_.setZero();
+  state_.cannula_load.setZero();
   if (cannula_) {
     for (size_t k = 0; k < cannula_nodes_.size(); ++k) {
       const int n = cannula_nodes_[k];
-      const double fn = cannula_normal_N_[n];
+      const double fn = state_.cannula_normal_N[n];
       if (!(fn > 0) || cannula_->friction == 0) continue;
-      const double r = std::hypot(x_(n, 1), x_(n, 2));
+      const double r = std::hypot(state_.x(n, 1), state_.x(n, 2));
       if (r == 0) continue;
-      const Eigen::Vector3d radial(0, x_(n, 1) / r, x_(n, 2) / r);
-      const Eigen::Vector3d vel = v_.row(n).transpose();
+      const Eigen::Vector3d radial(0, state_.x(n, 1) / r, state_.x(n, 2) / r);
+      const Eigen::Vector3d vel = state_.v.row(n).transpose();
       const Eigen::Vector3d vt = vel - vel.dot(radial) * radial;
       const double speed = vt.norm();
-      if (speed > 0) cannula_load_.segment<3>(3 * n) -= std::min(cannula_->friction * fn, 0.5 * mass_[n] / step_ms_ * speed) * vt / speed;
+      if (speed > 0) state_.cannula_load.segment<3>(3 * n) -= std::min(cannula_->friction * fn, 0.5 * mass_[n] / step_ms_ * speed) * vt / speed;
     }
   }
-  if (!load_.allFinite() || !cannula_load_.allFinite())
-    throw SolverError(fmt::format("the needle's loads became non-finite at t = {:.6g} ms", time_ms_));
+  if (!state_.load.allFinite() || !state_.cannula_load.allFinite())
+    throw SolverError(fmt::format("the needle's loads became non-finite at t = {:.6g} ms", state_.time_ms));
 }
 
 void ImplicitNeedle::apply_loads(NeedleLoads& loads) {
   evaluate_loads(loads);
   // The state at t = 0 is in equilibrium with these loads: they start the first step's trapezoid.
-  old_load_ = load_;
-  old_cannula_load_ = cannula_load_;
+  state_.old_load = state_.load;
+  state_.old_cannula_load = state_.cannula_load;
   start_accelerations();
 }
 
 void ImplicitNeedle::start_accelerations() {
   // M w'' = f - K w - M e d'' with the drive's acceleration over the first step.
   const double h = step_ms_;
-  const double accel = (supports_.profile.velocity_mm_per_ms(time_ms_ + h) - supports_.profile.velocity_mm_per_ms(time_ms_)) / h;
-  const Eigen::VectorXd elastic = K_ * w_;
+  const double accel = (supports_.profile.velocity_mm_per_ms(state_.time_ms + h) - supports_.profile.velocity_mm_per_ms(state_.time_ms)) / h;
+  const Eigen::VectorXd elastic = K_ * state_.w;
   for (size_t f = 0; f < free_dof_.size(); ++f) {
     const int d = free_dof_[f];
-    wdd_[d] = (load_[d] + cannula_load_[d] - elastic[d]) / mass_[d / 3] - accel * supports_.direction[d % 3];
+    state_.wdd[d] = (state_.load[d] + state_.cannula_load[d] - elastic[d]) / mass_[d / 3] - accel * supports_.direction[d % 3];
   }
+}
+
+Eigen::SparseMatrix<double> ImplicitNeedle::step_matrix(double dt) const {
+  Eigen::SparseMatrix<double> A = K_free_;
+  for (Eigen::Index f = 0; f < A.rows(); ++f) A.coeffRef(f, f) += 4.0 / (dt * dt) * mass_free_[f];
+  return A;
 }
 
 ImplicitNeedle::Factor& ImplicitNeedle::factor_for(double dt) {
@@ -148,8 +154,7 @@ ImplicitNeedle::Factor& ImplicitNeedle::factor_for(double dt) {
       return *factors_.front().second;
     }
   const auto start = std::chrono::steady_clock::now();
-  Eigen::SparseMatrix<double> A = K_free_;
-  for (Eigen::Index f = 0; f < A.rows(); ++f) A.coeffRef(f, f) += 4.0 / (dt * dt) * mass_free_[f];
+  const Eigen::SparseMatrix<double> A = step_matrix(dt);
   auto factor = std::make_unique<Factor>();
   factor->llt.compute(A.selfadjointView<Eigen::Lower>());
   if (factor->llt.info() != Eigen::Success) throw SolverError("the implicit needle's step matrix could not be factored");
@@ -164,49 +169,12 @@ ImplicitNeedle::Factor& ImplicitNeedle::factor_for(double dt) {
 void ImplicitNeedle::advance_to(double end_time_ms, NeedleLoads& loads) {
   // Steps of h, then the remainder (a whole number of grid steps when the coupled step plans it).
   const double tolerance = 1e-9 * step_ms_;
-  while (end_time_ms - time_ms_ > tolerance) step(end_time_ms - time_ms_ > step_ms_ + tolerance ? step_ms_ : end_time_ms - time_ms_, loads);
-}
-
-ImplicitNeedle::State ImplicitNeedle::capture() const {
-  return State{w_,      wd_,       wdd_,     load_,   cannula_load_, old_load_,   old_cannula_load_,           cannula_normal_N_, x_,
-               v_,      external_, contact_, max_cannula_penetration_mm_, time_ms_, steps_, energy_, drive_reaction_, drive_impulse_};
-}
-
-ImplicitNeedle::State ImplicitNeedle::release() {
-  return State{std::move(w_),       std::move(wd_),           std::move(wdd_),
-               std::move(load_),    std::move(cannula_load_), std::move(old_load_),
-               std::move(old_cannula_load_), std::move(cannula_normal_N_), std::move(x_),
-               std::move(v_),       std::move(external_),     contact_,
-               max_cannula_penetration_mm_,  time_ms_,        steps_,
-               energy_,             drive_reaction_,          drive_impulse_};
-}
-
-void ImplicitNeedle::restore(State&& s) {
-  w_ = std::move(s.w);
-  wd_ = std::move(s.wd);
-  wdd_ = std::move(s.wdd);
-  load_ = std::move(s.load);
-  cannula_load_ = std::move(s.cannula_load);
-  old_load_ = std::move(s.old_load);
-  old_cannula_load_ = std::move(s.old_cannula_load);
-  cannula_normal_N_ = std::move(s.cannula_normal_N);
-  x_ = std::move(s.x);
-  v_ = std::move(s.v);
-  external_ = std::move(s.external);
-  contact_ = s.contact;
-  max_cannula_penetration_mm_ = s.max_cannula_penetration_mm;
-  time_ms_ = s.time_ms;
-  steps_ = s.steps;
-  energy_ = s.energy;
-  drive_reaction_ = s.drive_reaction;
-  drive_impulse_ = s.drive_impulse;
+  while (end_time_ms - state_.time_ms > tolerance) step(end_time_ms - state_.time_ms > step_ms_ + tolerance ? step_ms_ : end_time_ms - state_.time_ms, loads);
 }
 
 bool ImplicitNeedle::speculate_advance(double end_time_ms, NeedleLoads& loads) {
   speculation_.reset();
-  State before = capture();
-  const long from_steps = steps_;
-  const double from_ms = time_ms_;
+  State before = state_;
   bool made = true;
   try {
     advance_to(end_time_ms, loads);
@@ -214,30 +182,30 @@ bool ImplicitNeedle::speculate_advance(double end_time_ms, NeedleLoads& loads) {
     made = false;
   }
   if (made) {
-    speculation_ = release();
-    speculation_from_steps_ = from_steps;
-    speculation_from_ms_ = from_ms;
+    speculation_ = std::move(state_);
+    speculation_from_steps_ = before.steps;
+    speculation_from_ms_ = before.time_ms;
     speculation_end_ms_ = end_time_ms;
   }
-  restore(std::move(before));
+  state_ = std::move(before);
   return made;
 }
 
 bool ImplicitNeedle::adopt_speculation(double end_time_ms) {
   if (!speculation_) return false;
-  const bool same = speculation_from_steps_ == steps_ && speculation_from_ms_ == time_ms_ && speculation_end_ms_ == end_time_ms;
-  if (same) restore(std::move(*speculation_));
+  const bool same = speculation_from_steps_ == state_.steps && speculation_from_ms_ == state_.time_ms && speculation_end_ms_ == end_time_ms;
+  if (same) state_ = std::move(*speculation_);
   speculation_.reset();
   return same;
 }
 
 void ImplicitNeedle::step(double dt, NeedleLoads& loads) {
   Factor& factor = factor_for(dt);
-  const double t0 = time_ms_, t1 = time_ms_ + dt;
+  const double t0 = state_.time_ms, t1 = state_.time_ms + dt;
   const Eigen::Vector3d e = supports_.direction;
   double accel = (supports_.profile.velocity_mm_per_ms(t1) - supports_.profile.velocity_mm_per_ms(t0)) / dt;  // the drive's mean
   const double drive_step = supports_.profile.displacement_mm(t1) - supports_.profile.displacement_mm(t0);
-  const Eigen::Vector3d momentum_before = momentum(), reaction_before = drive_reaction_;
+  const Eigen::Vector3d momentum_before = momentum(), reaction_before = state_.drive_reaction;
   // A stop without deceleration within the step (moving at the travel's end, still after it) is a jump of the base's
   // velocity, not an acceleration the frame could carry as a load over the step: the held base stops at once and the
   // free nodes keep their velocity (the steel rings axially), so their velocity relative to the base grows by the
@@ -246,7 +214,7 @@ void ImplicitNeedle::step(double dt, NeedleLoads& loads) {
   const bool stops_now = supports_.profile.decel_time_ms == 0 && t0 <= travel_end && travel_end < t1;
   if (stops_now) {
     const double jump = supports_.profile.velocity_mm_per_ms(t0) - supports_.profile.velocity_mm_per_ms(t1);
-    for (const int d : free_dof_) wd_[d] += jump * e[d % 3];
+    for (const int d : free_dof_) state_.wd[d] += jump * e[d % 3];
     accel = 0;
   }
   // The loads at the step's start, held over it (the contact's and the cannula's).
@@ -258,37 +226,37 @@ void ImplicitNeedle::step(double dt, NeedleLoads& loads) {
   for (Eigen::Index f = 0; f < nf; ++f) {
     const int d = free_dof_[static_cast<size_t>(f)];
     const double m = mass_free_[f];
-    rhs[f] = load_[d] + cannula_load_[d] - m * accel * e[d % 3] + m * (c0 * w_[d] + c1 * wd_[d] + wdd_[d]);
+    rhs[f] = state_.load[d] + state_.cannula_load[d] - m * accel * e[d % 3] + m * (c0 * state_.w[d] + c1 * state_.wd[d] + state_.wdd[d]);
   }
   Eigen::VectorXd w_free = factor.llt.solve(rhs);
   const double spring_energy_term = cannula_ ? hold_in_cannula(factor, w_free, supports_.profile.displacement_mm(t1) * e) : 0.0;
   if (!w_free.allFinite()) throw SolverError(fmt::format("the implicit needle's state became non-finite at t = {:.6g} ms", t1));
-  Eigen::VectorXd dw = Eigen::VectorXd::Zero(w_.size());
+  Eigen::VectorXd dw = Eigen::VectorXd::Zero(state_.w.size());
   for (Eigen::Index f = 0; f < nf; ++f) {
     const int d = free_dof_[static_cast<size_t>(f)];
-    const double wdd_new = c0 * (w_free[f] - w_[d] - dt * wd_[d]) - wdd_[d];
-    wd_[d] += 0.5 * dt * (wdd_[d] + wdd_new);
-    wdd_[d] = wdd_new;
-    dw[d] = w_free[f] - w_[d];
-    w_[d] = w_free[f];
+    const double wdd_new = c0 * (w_free[f] - state_.w[d] - dt * state_.wd[d]) - state_.wdd[d];
+    state_.wd[d] += 0.5 * dt * (state_.wdd[d] + wdd_new);
+    state_.wdd[d] = wdd_new;
+    dw[d] = w_free[f] - state_.w[d];
+    state_.w[d] = w_free[f];
   }
-  time_ms_ = t1;
+  state_.time_ms = t1;
   update_state();
 
   // Work of the held loads over the step (trapezoid of the loads at the step's two ends, as Newmark's
   // equilibrium at each end used them), through the absolute displacement.
   double external_work = 0, cannula_work = 0;
-  for (Eigen::Index i = 0; i < x_.rows(); ++i) {
+  for (Eigen::Index i = 0; i < state_.x.rows(); ++i) {
     const Eigen::Vector3d dx = dw.segment<3>(3 * i) + drive_step * e;
-    external_work += 0.5 * (old_load_.segment<3>(3 * i) + load_.segment<3>(3 * i)).dot(dx);
-    cannula_work += 0.5 * (old_cannula_load_.segment<3>(3 * i) + cannula_load_.segment<3>(3 * i)).dot(dx);
+    external_work += 0.5 * (state_.old_load.segment<3>(3 * i) + state_.load.segment<3>(3 * i)).dot(dx);
+    cannula_work += 0.5 * (state_.old_cannula_load.segment<3>(3 * i) + state_.cannula_load.segment<3>(3 * i)).dot(dx);
   }
   // The supports' reaction from the needle's momentum balance (elastic forces sum to zero).
   Eigen::Vector3d loads_sum = Eigen::Vector3d::Zero();
-  for (Eigen::Index i = 0; i < x_.rows(); ++i)
-    loads_sum += 0.5 * (old_load_.segment<3>(3 * i) + load_.segment<3>(3 * i) + old_cannula_load_.segment<3>(3 * i) + cannula_load_.segment<3>(3 * i));
-  drive_reaction_ = (momentum() - momentum_before) / dt - loads_sum;
-  drive_impulse_ += dt * drive_reaction_;
+  for (Eigen::Index i = 0; i < state_.x.rows(); ++i)
+    loads_sum += 0.5 * (state_.old_load.segment<3>(3 * i) + state_.load.segment<3>(3 * i) + state_.old_cannula_load.segment<3>(3 * i) + state_.cannula_load.segment<3>(3 * i));
+  state_.drive_reaction = (momentum() - momentum_before) / dt - loads_sum;
+  state_.drive_impulse += dt * state_.drive_reaction;
   // The reaction's work through the base's motion. At a stop, the impulse J that stops the held base's mass works
   // J . (v_before + v_after) / 2 (the base's kinetic energy); until the stop the base moved under the reaction it had
   // before (after it, it does not move, and the reaction the stop sets up does no work).
@@ -297,28 +265,28 @@ void ImplicitNeedle::step(double dt, NeedleLoads& loads) {
     for (const int i : supports_.driven) held_mass += mass_[i];
     const double v0 = supports_.profile.velocity_mm_per_ms(t0), v1 = supports_.profile.velocity_mm_per_ms(t1);
     const Eigen::Vector3d stop_impulse = held_mass * (v1 - v0) * e;
-    energy_.drive_work_mJ += reaction_before.dot(drive_step * e) + stop_impulse.dot(0.5 * (v0 + v1) * e);
+    state_.energy.drive_work_mJ += reaction_before.dot(drive_step * e) + stop_impulse.dot(0.5 * (v0 + v1) * e);
   } else {
-    energy_.drive_work_mJ += drive_reaction_.dot(drive_step * e);
+    state_.energy.drive_work_mJ += state_.drive_reaction.dot(drive_step * e);
   }
-  energy_.external_work_mJ += external_work;
-  energy_.cannula_work_mJ += cannula_work;
-  old_load_ = load_;
-  old_cannula_load_ = cannula_load_;
-  energy_.kinetic_mJ = 0.5 * mass_.dot(v_.rowwise().squaredNorm());
+  state_.energy.external_work_mJ += external_work;
+  state_.energy.cannula_work_mJ += cannula_work;
+  state_.old_load = state_.load;
+  state_.old_cannula_load = state_.cannula_load;
+  state_.energy.kinetic_mJ = 0.5 * mass_.dot(state_.v.rowwise().squaredNorm());
   // 1/2 w.K w from the equation just solved, (K + c0 M + U U^T) w = rhs + g on the free components (w = 0 on the
   // held ones): K w = rhs - c0 M w + (g - U U^T w), without a product with K. The springs' part is
   // hold_in_cannula's.
   double work = spring_energy_term;
   for (Eigen::Index f = 0; f < nf; ++f) work += w_free[f] * (rhs[f] - c0 * mass_free_[f] * w_free[f]);
-  energy_.strain_mJ = 0.5 * work;
-  ++steps_;
-  if (!std::isfinite(energy_.kinetic_mJ) || !std::isfinite(energy_.strain_mJ))
-    throw SolverError(fmt::format("the needle's energy became non-finite at t = {:.6g} ms", time_ms_));
-  const double work_scale = std::max({std::abs(energy_.drive_work_mJ), std::abs(energy_.cannula_work_mJ), std::abs(energy_.external_work_mJ)});
-  if (work_scale > 1e-6 && energy_.balance_error() > options_.max_energy_error)
+  state_.energy.strain_mJ = 0.5 * work;
+  ++state_.steps;
+  if (!std::isfinite(state_.energy.kinetic_mJ) || !std::isfinite(state_.energy.strain_mJ))
+    throw SolverError(fmt::format("the needle's energy became non-finite at t = {:.6g} ms", state_.time_ms));
+  const double work_scale = std::max({std::abs(state_.energy.drive_work_mJ), std::abs(state_.energy.cannula_work_mJ), std::abs(state_.energy.external_work_mJ)});
+  if (work_scale > 1e-6 && state_.energy.balance_error() > options_.max_energy_error)
     throw SolverError(fmt::format("the needle's energy balance drifted by {:.3g} % at t = {:.6g} ms (limit {:.3g} %)",
-                                  100 * energy_.balance_error(), time_ms_, 100 * options_.max_energy_error));
+                                  100 * state_.energy.balance_error(), state_.time_ms, 100 * options_.max_energy_error));
 }
 
 const Eigen::VectorXd& ImplicitNeedle::column(Factor& factor, int dof) {
@@ -426,23 +394,23 @@ double ImplicitNeedle::hold_in_cannula(Factor& factor, Eigen::VectorXd& w, const
   }
   w = solved;
   // The springs' forces at t + dt, and the report.
-  cannula_normal_N_.setZero();
-  contact_ = CannulaContact{};
+  state_.cannula_normal_N.setZero();
+  state_.contact = CannulaContact{};
   for (const Spring& s : active) {
     const double gap = s.normal.dot(position(s.node, w)) - r_in;
     if (!(gap > 0)) continue;
     const double fn = s.k * gap;
-    cannula_normal_N_[s.node] = fn;
-    cannula_load_.segment<3>(3 * s.node) -= fn * s.normal;
-    ++contact_.nodes_in_contact;
-    contact_.max_penetration_mm = std::max(contact_.max_penetration_mm, gap);
-    contact_.normal_force_N += fn;
-    contact_.force_N -= fn * s.normal;
+    state_.cannula_normal_N[s.node] = fn;
+    state_.cannula_load.segment<3>(3 * s.node) -= fn * s.normal;
+    ++state_.contact.nodes_in_contact;
+    state_.contact.max_penetration_mm = std::max(state_.contact.max_penetration_mm, gap);
+    state_.contact.normal_force_N += fn;
+    state_.contact.force_N -= fn * s.normal;
   }
-  max_cannula_penetration_mm_ = std::max(max_cannula_penetration_mm_, contact_.max_penetration_mm);
-  if (contact_.max_penetration_mm > options_.max_penetration_mm)
+  state_.max_cannula_penetration_mm = std::max(state_.max_cannula_penetration_mm, state_.contact.max_penetration_mm);
+  if (state_.contact.max_penetration_mm > options_.max_penetration_mm)
     throw SolverError(fmt::format("the needle passed the cannula's bore by {:.3g} mm at t = {:.6g} ms (limit {:.3g} mm): "
-                                  "runaway penetration", contact_.max_penetration_mm, time_ms_, options_.max_penetration_mm));
+                                  "runaway penetration", state_.contact.max_penetration_mm, state_.time_ms, options_.max_penetration_mm));
   return energy_term;
 }
 
@@ -451,7 +419,7 @@ void ImplicitNeedle::add_summary(nlohmann::json& summary) const {
   summary["needle_factorizations"] = factorizations_;
   summary["needle_factor_s"] = factor_s_;
   summary["needle_free_dofs"] = free_dof_.size();
-  summary["needle_max_cannula_penetration_mm"] = max_cannula_penetration_mm_;
+  summary["needle_max_cannula_penetration_mm"] = state_.max_cannula_penetration_mm;
 }
 
 }  // namespace needle

@@ -58,19 +58,22 @@ class ImplicitNeedle : public NeedleModel {
   bool speculate_advance(double end_time_ms, NeedleLoads& loads) override;
   bool adopt_speculation(double end_time_ms) override;
 
-  double time_ms() const override { return time_ms_; }
-  long steps() const override { return steps_; }
-  const Eigen::MatrixX3d& positions_mm() const override { return x_; }
-  const Eigen::MatrixX3d& velocities_mm_per_ms() const override { return v_; }
-  const NeedleEnergy& energy() const override { return energy_; }
-  Eigen::Vector3d drive_displacement_mm() const override { return supports_.profile.displacement_mm(time_ms_) * supports_.direction; }
-  Eigen::Vector3d drive_reaction_N() const override { return drive_reaction_; }
-  Eigen::Vector3d drive_impulse_N_ms() const override { return drive_impulse_; }
-  ElementStresses element_stresses() const override { return needle_.element_stresses(x_); }
+  double time_ms() const override { return state_.time_ms; }
+  long steps() const override { return state_.steps; }
+  const Eigen::MatrixX3d& positions_mm() const override { return state_.x; }
+  const Eigen::MatrixX3d& velocities_mm_per_ms() const override { return state_.v; }
+  const NeedleEnergy& energy() const override { return state_.energy; }
+  Eigen::Vector3d drive_displacement_mm() const override { return supports_.profile.displacement_mm(state_.time_ms) * supports_.direction; }
+  Eigen::Vector3d drive_reaction_N() const override { return state_.drive_reaction; }
+  Eigen::Vector3d drive_impulse_N_ms() const override { return state_.drive_impulse; }
+  ElementStresses element_stresses() const override { return needle_.element_stresses(state_.x); }
   void add_summary(nlohmann::json& summary) const override;
 
-  const CannulaContact& cannula_contact() const { return contact_; }
-  double max_cannula_penetration_mm() const { return max_cannula_penetration_mm_; }
+  const CannulaContact& cannula_contact() const { return state_.contact; }
+  double max_cannula_penetration_mm() const { return state_.max_cannula_penetration_mm; }
+  // The matrix a step of dt factors, K + 4 M / dt^2 on the free components (lower triangle): bench_needle times its
+  // factorisations.
+  Eigen::SparseMatrix<double> step_matrix(double dt) const;
   int factorizations() const { return factorizations_; }
   double factor_seconds() const { return factor_s_; }
 
@@ -78,19 +81,23 @@ class ImplicitNeedle : public NeedleModel {
   struct Factor;
   void step(double dt, NeedleLoads& loads);
   Factor& factor_for(double dt);  // the factored step matrix for dt, from the cache or new
-  // The held loads at the current state: the contact's (loads) into load_, the cannula's friction into cannula_load_.
+  // The held loads at the current state: the contact's (loads) into state_.load, the cannula's friction into its cannula_load.
   void evaluate_loads(NeedleLoads& loads);
   // The cannula's normal springs on the free components solved into w (free components), iterating the set of
-  // nodes in contact; their forces at t + dt are added to cannula_load_. drive_mm: d(t + dt) e. Returns the
+  // nodes in contact; their forces at t + dt are added to state_.cannula_load. drive_mm: d(t + dt) e. Returns the
   // springs' (g - U U^T w).w of the system solved last (step's strain energy).
   double hold_in_cannula(Factor& factor, Eigen::VectorXd& w, const Eigen::Vector3d& drive_mm);
   const Eigen::VectorXd& column(Factor& factor, int dof);  // A^-1 e_dof on the free components, cached
-  void update_state();        // x_, v_ from w, w' and the drive
+  void update_state();        // the state's x, v from w, w' and the drive
   void start_accelerations();  // w'' in equilibrium with the held loads at the current state
 
-  // Everything a step changes (the factor cache and its counts aside: the same factors either way).
+  // Everything a step changes, in one place so that a span can be taken ahead and kept (the factor cache and its
+  // counts aside: the same factors either way).
   struct State {
-    Eigen::VectorXd w, wd, wdd, load, cannula_load, old_load, old_cannula_load, cannula_normal_N;
+    Eigen::VectorXd w, wd, wdd;                   // on all 3 n components
+    Eigen::VectorXd load, cannula_load;           // held over the current step (3 n)
+    Eigen::VectorXd old_load, old_cannula_load;
+    Eigen::VectorXd cannula_normal_N;             // per node (all): the last step's normal force magnitude
     Eigen::MatrixX3d x, v;
     NodalForces external;
     CannulaContact contact;
@@ -99,9 +106,6 @@ class ImplicitNeedle : public NeedleModel {
     NeedleEnergy energy;
     Eigen::Vector3d drive_reaction = Eigen::Vector3d::Zero(), drive_impulse = Eigen::Vector3d::Zero();
   };
-  State capture() const;
-  State release();  // the state moved out (the members are left empty until restore)
-  void restore(State&& state);
 
   const FeNeedle& needle_;
   NeedleSupports supports_;
@@ -112,9 +116,6 @@ class ImplicitNeedle : public NeedleModel {
   std::vector<int> cannula_nodes_;         // surface nodes
   std::vector<double> cannula_k_;          // per node: the normal spring (N/mm)
   std::vector<int> free_index_;            // per component: its free index, -1 held
-  Eigen::VectorXd cannula_normal_N_;       // per node (all): the last step's normal force magnitude
-  CannulaContact contact_;
-  double max_cannula_penetration_mm_ = 0;
   std::vector<int> free_dof_;              // free components, as 3 node + axis
   Eigen::SparseMatrix<double> K_;          // full stiffness (the accelerations in equilibrium with the loads)
   Eigen::SparseMatrix<double> K_free_;     // on the free components, lower triangle
@@ -122,15 +123,7 @@ class ImplicitNeedle : public NeedleModel {
   std::vector<std::pair<double, std::unique_ptr<Factor>>> factors_;  // by step, the last used first
   double factor_s_ = 0;
   int factorizations_ = 0;
-  Eigen::VectorXd w_, wd_, wdd_;           // on all 3 n components
-  Eigen::VectorXd load_, cannula_load_;    // held over the current step (3 n)
-  Eigen::VectorXd old_load_, old_cannula_load_;
-  NodalForces external_;
-  Eigen::MatrixX3d x_, v_;
-  double time_ms_ = 0;
-  long steps_ = 0;
-  NeedleEnergy energy_;
-  Eigen::Vector3d drive_reaction_ = Eigen::Vector3d::Zero(), drive_impulse_ = Eigen::Vector3d::Zero();
+  State state_;
   // The kept speculation: made from the state at (steps, time) to end_ms.
   std::optional<State> speculation_;
   long speculation_from_steps_ = -1;

@@ -60,6 +60,21 @@ double strain_energy_by_stiffness(const FeNeedle& fe, const ImplicitNeedle& mode
   return 0.5 * flat.dot(fe.stiffness_matrix() * flat);
 }
 
+// The drive of the driven-base tests: 0.3 mm at 8 mm/ms after a 0.02 ms ramp, and the implicit step they take.
+InsertionProfile short_drive() {
+  InsertionProfile p;
+  p.accel_time_ms = 0.02;
+  p.speed_mm_per_ms = 8.0;
+  p.travel_mm = 0.3;
+  return p;
+}
+
+NeedleDynamicsOptions step_of(double implicit_step_ms) {
+  NeedleDynamicsOptions o;
+  o.implicit_step_ms = implicit_step_ms;
+  return o;
+}
+
 double mean_tip_y(const NeedleModel& model, const std::vector<int>& nodes) {
   double sum = 0;
   for (int n : nodes) sum += model.positions_mm()(n, 1) - model.mesh().X(n, 1);
@@ -153,12 +168,8 @@ TEST_CASE("Implicit needle: a tip load applied at once swings as the explicit FE
 
 TEST_CASE("Implicit needle: driven at its base it moves with the drive and the drive's impulse is its momentum", "[solver][needle][gmsh]") {
   const FeNeedle fe(rod(), NeedleMaterial{}, 0.0);
-  InsertionProfile profile;
-  profile.accel_time_ms = 0.02;
-  profile.speed_mm_per_ms = 8.0;
-  profile.travel_mm = 0.3;
-  NeedleDynamicsOptions options;
-  options.implicit_step_ms = 1e-3;
+  const InsertionProfile profile = short_drive();
+  NeedleDynamicsOptions options = step_of(1e-3);
   ImplicitNeedle needle(fe, driven_base_supports(fe.mesh(), profile), std::nullopt, options);
   TipLoad none;
   needle.advance_to(profile.end_time_ms(), none);
@@ -184,12 +195,8 @@ TEST_CASE("Implicit needle: driven at its base it moves with the drive and the d
 TEST_CASE("Implicit needle: a span taken ahead leaves the state as it was, and adopted it is the span advance_to takes, bit for bit",
           "[solver][needle][gmsh][ahead]") {
   const FeNeedle fe(rod(), NeedleMaterial{}, 0.0);
-  InsertionProfile profile;
-  profile.accel_time_ms = 0.02;
-  profile.speed_mm_per_ms = 8.0;
-  profile.travel_mm = 0.3;
-  NeedleDynamicsOptions options;
-  options.implicit_step_ms = 1e-3;
+  const InsertionProfile profile = short_drive();
+  NeedleDynamicsOptions options = step_of(1e-3);
   TipLoad load;
   load.nodes = tip_nodes(fe.mesh());
   load.total_N = 0.01;
@@ -235,13 +242,9 @@ TEST_CASE("Implicit needle: stopped at once after its travel it rings with the k
   // (the stopping impulse's work, m_base v^2 / 2), and its account stays closed over the ringing; its momentum is the
   // drive's impulse throughout.
   const FeNeedle fe(rod(), NeedleMaterial{}, 0.0);
-  InsertionProfile profile;
-  profile.accel_time_ms = 0.02;
-  profile.speed_mm_per_ms = 8.0;
-  profile.travel_mm = 0.3;
+  InsertionProfile profile = short_drive();
   profile.hold_ms = 0.05;
-  NeedleDynamicsOptions options;
-  options.implicit_step_ms = 1e-3;
+  const NeedleDynamicsOptions options = step_of(1e-3);
   const NeedleSupports supports = driven_base_supports(fe.mesh(), profile);
   ImplicitNeedle needle(fe, supports, std::nullopt, options);
   TipLoad none;
